@@ -1,0 +1,35 @@
+// Simulation parameters shared by every stage; mirrored by `SimParams` in solver/src/gpu/params.rs
+// (a test checks the two layouts agree). Lengths in m, times in s, densities in kg/m3.
+
+struct Phase {
+    rho0: f32,      // rest density of the Tait equation
+    mass: f32,      // particle mass (per metre of width in 2-D)
+    mu: f32,        // dynamic viscosity, Pa s
+    mobile: f32,    // 1 for fluid, 0 for DBC wall particles
+}
+
+struct SimParams {
+    n_particles: u32,
+    n_cells: u32,
+    viscosity_mode: u32,     // 0 artificial (Monaghan 1992), 1 laminar (Morris 1997)
+    diffusion_mode: u32,     // 0 none, 1 Molteni-Colagrossi 2009, 2 Fourtakas 2019
+    grid_dims: vec4<u32>,    // cells along x, y, z (z = 1 in 2-D)
+    grid_origin: vec4<f32>,  // xyz of the grid corner, w = 1 / cell size
+    gravity: vec4<f32>,      // xyz, w = |g| along the vertical axis
+    h: f32,
+    kernel_ad: f32,          // Wendland C2 normalisation a_d
+    c0: f32,
+    eta2: f32,               // 0.01 h^2, keeps 1 / r^2 finite
+    delta_h_c0: f32,         // density-diffusion delta * h * c0
+    alpha: f32,              // artificial viscosity coefficient
+    cfl: f32,
+    dt_visc: f32,            // viscous bound 0.125 h^2 rho0 / mu (laminar), else huge
+    dt_min: f32,             // a step below this is a blow-up
+    rho_ratio_max: f32,      // |rho / rho0 - 1| above this is a runaway density
+    vertical_axis: u32,      // 1 in 2-D (y up), 2 in 3-D (z up)
+    n_probes: u32,
+    phases: array<Phase, 4>,
+    tait_b: vec4<f32>,       // c0^2 rho0 / 7 per phase
+}
+
+@group(0) @binding(0) var<uniform> params: SimParams;

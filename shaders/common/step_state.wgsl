@@ -1,0 +1,17 @@
+// The state of the GPU-resident step loop: the host writes it at the start of a chunk and
+// reads it back at the end; no stage waits for the host in between.
+
+struct StepState {
+    dt: f32,                    // the step being taken, s (0 once the chunk is done)
+    t_rel: f32,                 // time since the chunk started, s
+    t_target: f32,              // the chunk ends when t_rel reaches it
+    steps: u32,                 // steps taken in this chunk
+    dt_min_bits: atomic<u32>,   // min over particles of the stable step, as f32 bits (> 0)
+    status: atomic<u32>,        // health flags, see `Health` in solver/src/simulation.rs
+    last_dt: f32,               // the last non-zero step, s
+    pad: u32,
+}
+
+const STATUS_NON_FINITE: u32 = 1u;
+const STATUS_DENSITY_RUNAWAY: u32 = 2u;
+const STATUS_DT_COLLAPSE: u32 = 4u;

@@ -1,0 +1,117 @@
+// Weakly compressible SPH interaction (Eqs. 9-10 with the Tait pressure of Eq. 4):
+// continuity with density diffusion (Molteni & Colagrossi 2009; hydrostatic correction of
+// Fourtakas et al. 2019), pressure gradient, artificial (Monaghan 1992) or laminar (Morris et
+// al. 1997) viscosity, gravity; DBC walls (Crespo et al. 2007) only gather density.
+// Also the per-particle stable step of the variable time step, min-reduced into `state`.
+// Reference: solver/src/physics/interaction.rs.
+
+@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> vel_rho: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> cell_starts: array<u32>;
+@group(0) @binding(4) var<storage, read_write> forces: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> state: StepState;
+
+// The corrector's half-step forces do not set the step: only the predictor's do (DualSPHysics).
+override REDUCE_DT: bool = true;
+// Neighbours are visited in chunks of fixed length: lavapipe runs fixed-count loops much faster.
+override NEIGHBOUR_CHUNK: u32 = 8u;
+
+@compute @workgroup_size(64)
+fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.n_particles) {
+        return;
+    }
+    let pos_i = positions[i];
+    let vr_i = vel_rho[i];
+    let phase_i = bitcast<u32>(pos_i.w);
+    let mobile_i = params.phases[phase_i].mobile > 0.5;
+    let rho_i = vr_i.w;
+    let press_i = tait_pressure(rho_i, phase_i) / (rho_i * rho_i);
+    let h = params.h;
+    let four_h2 = 4.0 * h * h;
+    let r2_min = 1e-12 * h * h;
+    let vert = params.vertical_axis;
+    let g_vert = params.gravity.w;
+    let rho0_i = params.phases[phase_i].rho0;
+    let b_i = params.tait_b[phase_i];
+    let mu_i = params.phases[phase_i].mu;
+
+    var acc = vec3<f32>(0.0);
+    var drho = 0.0;
+    var visc_max = 0.0;
+    let cell = cell_coords(pos_i.xyz);
+    for (var row = 0u; row < STENCIL_ROWS; row++) {
+        let range = stencil_row(cell, row);
+        for (var base = range.x; base < range.y; base += NEIGHBOUR_CHUNK) {
+        for (var k = 0u; k < NEIGHBOUR_CHUNK; k++) {
+            let j = base + k;
+            if (j >= range.y) {
+                break;
+            }
+            let pos_j = positions[j];
+            let dx = pos_i.xyz - pos_j.xyz;
+            let r2 = dot(dx, dx);
+            if (r2 >= four_h2 || r2 < r2_min) {
+                continue;
+            }
+            let phase_j = bitcast<u32>(pos_j.w);
+            let mobile_j = params.phases[phase_j].mobile > 0.5;
+            if (!mobile_i && !mobile_j) {
+                continue;
+            }
+            let vr_j = vel_rho[j];
+            let dv = vr_i.xyz - vr_j.xyz;
+            let f = kernel_grad_factor(sqrt(r2));
+            let m_j = params.phases[phase_j].mass;
+            let rho_j = vr_j.w;
+            let vdotr = dot(dv, dx);
+            drho += m_j * vdotr * f;
+            if (!mobile_i) {
+                continue;
+            }
+            if (params.diffusion_mode != 0u && mobile_j && phase_j == phase_i) {
+                var rho_h = 0.0;
+                if (params.diffusion_mode == 2u) {
+                    let dz = pos_i[vert] - pos_j[vert];
+                    rho_h = rho0_i * (pow(1.0 + rho0_i * g_vert * dz / b_i, 1.0 / 7.0) - 1.0);
+                }
+                drho += params.delta_h_c0 * 2.0 * (rho_j - rho_i - rho_h) * (-r2 * f) / (r2 + params.eta2) * (m_j / rho_j);
+            }
+            let press_j = tait_pressure(rho_j, phase_j) / (rho_j * rho_j);
+            var coef = -m_j * (press_i + press_j);
+            let mu_ij = h * vdotr / (r2 + params.eta2);
+            visc_max = max(visc_max, abs(mu_ij));
+            if (params.viscosity_mode == 0u) {
+                if (vdotr < 0.0) {
+                    let pi_ij = -params.alpha * params.c0 * mu_ij / (0.5 * (rho_i + rho_j));
+                    coef -= m_j * pi_ij;
+                }
+                acc += coef * f * dx;
+            } else {
+                let mu_j = params.phases[phase_j].mu;
+                acc += coef * f * dx + (m_j * (mu_i + mu_j) * (r2 * f) / (rho_i * rho_j * (r2 + params.eta2))) * dv;
+            }
+        }
+        }
+    }
+    var dt_i = 3.0e38;
+    if (mobile_i) {
+        acc += params.gravity.xyz;
+        let a = length(acc);
+        if (a > 0.0) {
+            dt_i = sqrt(h / a);
+        }
+        dt_i = min(dt_i, h / (params.c0 + visc_max));
+    } else {
+        acc = vec3<f32>(0.0);
+    }
+    forces[i] = vec4<f32>(acc, drho);
+    if (REDUCE_DT) {
+        // Most particles are not the minimum: read first, so few of them touch the atomic.
+        let bits = bitcast<u32>(dt_i);
+        if (bits < atomicLoad(&state.dt_min_bits)) {
+            atomicMin(&state.dt_min_bits, bits);
+        }
+    }
+}

@@ -1,0 +1,240 @@
+//! Turns a validated `Case` into particles on the dp lattice and the derived physical constants.
+//!
+//! Like DualSPHysics' GenCase, every particle sits on the lattice of integer multiples of dp:
+//! wall particles on the tank's faces and `layers - 1` rows outside them, fluid at the lattice
+//! points inside each block (`min < x <= max`) that no wall or earlier block already holds.
+
+use crate::config::{Case, SoundSpeed};
+use std::collections::HashSet;
+
+/// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
+pub const WALL_PHASE: u32 = 0;
+
+/// Particle state on the CPU, in the GPU's layout (see `gpu::params`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Particles {
+    /// x, y, z (z = 0 in 2-D) and, in w, the phase index as f32 bits.
+    pub positions: Vec<[f32; 4]>,
+    /// Velocity x, y, z and, in w, the density in kg/m3.
+    pub vel_rho: Vec<[f32; 4]>,
+    /// Stable identity of each particle (its index at generation).
+    pub ids: Vec<u32>,
+}
+
+impl Particles {
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.positions.is_empty()
+    }
+    pub fn phase(&self, i: usize) -> u32 {
+        self.positions[i][3].to_bits()
+    }
+}
+
+/// One phase as the solver sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhaseProps {
+    pub rho0: f64,
+    /// Mass per particle, kg (per metre of width in 2-D): rho0 dp^dim.
+    pub mass: f64,
+    pub viscosity_pa_s: f64,
+    pub mobile: bool,
+}
+
+/// The physical constants every stage needs, derived once from the case.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Derived {
+    pub h: f64,
+    pub c0: f64,
+    /// Height of the fluid used for c0 with `coefsound`, m.
+    pub fluid_height: f64,
+    /// Index 0 is the wall.
+    pub phases: Vec<PhaseProps>,
+}
+
+fn lattice_bounds(case: &Case) -> (Vec<i64>, Vec<i64>) {
+    let dp = case.numerics.dp_m;
+    let lo = case.domain.min_m.iter().map(|v| (v / dp).round() as i64).collect();
+    let hi = case.domain.max_m.iter().map(|v| (v / dp).round() as i64).collect();
+    (lo, hi)
+}
+
+/// Iterates the lattice points of the box `lo..=hi` (lattice indices).
+fn for_each_point(lo: &[i64], hi: &[i64], mut f: impl FnMut(&[i64])) {
+    let d = lo.len();
+    let mut p = lo.to_vec();
+    if lo.iter().zip(hi).any(|(a, b)| a > b) {
+        return;
+    }
+    loop {
+        f(&p);
+        let mut k = 0;
+        loop {
+            p[k] += 1;
+            if p[k] <= hi[k] {
+                break;
+            }
+            p[k] = lo[k];
+            k += 1;
+            if k == d {
+                return;
+            }
+        }
+    }
+}
+
+fn is_wall(case: &Case, p: &[i64], lo: &[i64], hi: &[i64]) -> bool {
+    let d = p.len();
+    let layers = i64::from(case.walls.layers);
+    let vert = d - 1;
+    let mut outside_or_on = false;
+    for k in 0..d {
+        let top_open = k == vert && !case.walls.closed_top;
+        if p[k] < lo[k] - (layers - 1) || (!top_open && p[k] > hi[k] + (layers - 1)) {
+            return false;
+        }
+        if p[k] <= lo[k] || (!top_open && p[k] >= hi[k]) {
+            outside_or_on = true;
+        }
+    }
+    outside_or_on
+}
+
+fn wall_box(case: &Case, lo: &[i64], hi: &[i64]) -> (Vec<i64>, Vec<i64>) {
+    let layers = i64::from(case.walls.layers);
+    let d = lo.len();
+    let wlo = lo.iter().map(|v| v - (layers - 1)).collect();
+    let whi = (0..d)
+        .map(|k| {
+            if k == d - 1 && !case.walls.closed_top {
+                hi[k]
+            } else {
+                hi[k] + layers - 1
+            }
+        })
+        .collect();
+    (wlo, whi)
+}
+
+fn block_bounds(case: &Case, min: &[f64], max: &[f64]) -> (Vec<i64>, Vec<i64>) {
+    let dp = case.numerics.dp_m;
+    let lo = min.iter().map(|v| (v / dp + 1e-6).floor() as i64 + 1).collect();
+    let hi = max.iter().map(|v| (v / dp + 1e-6).floor() as i64).collect();
+    (lo, hi)
+}
+
+/// Generates the particles of a case, walls first, then fluid blocks in file order.
+pub fn generate(case: &Case, derived: &Derived) -> Particles {
+    let dp = case.numerics.dp_m;
+    let d = case.dim();
+    let (lo, hi) = lattice_bounds(case);
+    let mut out = Particles::default();
+    let mut taken: HashSet<Vec<i64>> = HashSet::new();
+    let gravity = case.gravity_magnitude();
+    let push = |p: &[i64], phase: u32, rho: f64, out: &mut Particles| {
+        let mut pos = [0.0f32; 4];
+        for k in 0..d {
+            pos[k] = (p[k] as f64 * dp) as f32;
+        }
+        pos[3] = f32::from_bits(phase);
+        out.ids.push(out.positions.len() as u32);
+        out.positions.push(pos);
+        out.vel_rho.push([0.0, 0.0, 0.0, rho as f32]);
+    };
+    let (wlo, whi) = wall_box(case, &lo, &hi);
+    let wall_rho = derived.phases[WALL_PHASE as usize].rho0;
+    for_each_point(&wlo, &whi, |p| {
+        if is_wall(case, p, &lo, &hi) {
+            taken.insert(p.to_vec());
+            push(p, WALL_PHASE, wall_rho, &mut out);
+        }
+    });
+    for block in &case.fluid_blocks {
+        let Some(k) = case.phase_index(&block.phase) else {
+            continue;
+        };
+        let phase = k as u32 + 1;
+        let props = derived.phases[phase as usize];
+        let b = tait_b(derived.c0, props.rho0);
+        let top = block.max_m[d - 1];
+        let (blo, bhi) = block_bounds(case, &block.min_m, &block.max_m);
+        for_each_point(&blo, &bhi, |p| {
+            if taken.insert(p.to_vec()) {
+                // Hydrostatic start (inverse Tait law) so the column does not first bounce.
+                let depth = (top - p[d - 1] as f64 * dp).max(0.0);
+                let rho = props.rho0 * (1.0 + props.rho0 * gravity * depth / b).powf(1.0 / 7.0);
+                push(p, phase, rho, &mut out);
+            }
+        });
+    }
+    out
+}
+
+/// Number of particles `generate` would make, without making them (for limit checks).
+pub fn count(case: &Case) -> u64 {
+    let (lo, hi) = lattice_bounds(case);
+    let (wlo, whi) = wall_box(case, &lo, &hi);
+    let boxes = |a: &[i64], b: &[i64]| -> u64 { a.iter().zip(b).map(|(l, h)| (h - l + 1).max(0) as u64).product() };
+    let d = lo.len();
+    // Walls: the wall box minus its interior (lattice points strictly inside the tank's faces).
+    let inner_lo: Vec<i64> = lo.iter().map(|v| v + 1).collect();
+    let inner_hi: Vec<i64> = (0..d)
+        .map(|k| if k == d - 1 && !case.walls.closed_top { hi[k] } else { hi[k] - 1 })
+        .collect();
+    let mut n = boxes(&wlo, &whi) - boxes(&inner_lo, &inner_hi);
+    // Fluid blocks: an upper bound when blocks overlap, exact otherwise; it only guards limits.
+    for block in &case.fluid_blocks {
+        let (blo, bhi) = block_bounds(case, &block.min_m, &block.max_m);
+        let clo: Vec<i64> = blo.iter().zip(&inner_lo).map(|(a, b)| *a.max(b)).collect();
+        let chi: Vec<i64> = bhi.iter().zip(&inner_hi).map(|(a, b)| *a.min(b)).collect();
+        n += boxes(&clo, &chi);
+    }
+    n
+}
+
+fn tait_b(c0: f64, rho0: f64) -> f64 {
+    c0 * c0 * rho0 / 7.0
+}
+
+/// h, c0 and the phase table of a case.
+pub fn derive(case: &Case) -> Derived {
+    let d = case.dim();
+    let dp = case.numerics.dp_m;
+    let vmin = case.domain.min_m[d - 1];
+    let top = case
+        .fluid_blocks
+        .iter()
+        .map(|b| b.max_m[d - 1])
+        .fold(vmin, f64::max);
+    let fluid_height = top - vmin;
+    let c0 = match case.numerics.sound_speed {
+        SoundSpeed {
+            c0_m_per_s: Some(c),
+            ..
+        } => c,
+        SoundSpeed { coefsound, .. } => {
+            coefsound.unwrap_or(10.0) * (case.gravity_magnitude() * fluid_height).sqrt()
+        }
+    };
+    let vol = dp.powi(d as i32);
+    let mut phases = vec![PhaseProps {
+        rho0: case.phases[0].rho0_kg_per_m3,
+        mass: case.phases[0].rho0_kg_per_m3 * vol,
+        viscosity_pa_s: case.phases[0].viscosity_pa_s,
+        mobile: false,
+    }];
+    phases.extend(case.phases.iter().map(|p| PhaseProps {
+        rho0: p.rho0_kg_per_m3,
+        mass: p.rho0_kg_per_m3 * vol,
+        viscosity_pa_s: p.viscosity_pa_s,
+        mobile: true,
+    }));
+    Derived {
+        h: case.smoothing_length_m(),
+        c0,
+        fluid_height,
+        phases,
+    }
+}

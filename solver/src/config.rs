@@ -1,0 +1,383 @@
+//! Case files: one YAML document per case (see `launch_configs/`).
+//!
+//! Every length is in metres, every time in seconds, and the unit is part of the field name
+//! (`dp_m`, `end_s`). Unknown fields are rejected so that a misspelt key cannot silently fall
+//! back to a default. Parse errors and validation errors both name the offending field.
+
+use serde::Deserialize;
+use std::path::Path;
+
+/// Why a case file was refused. `field` is the dotted path of the key (`numerics.dp_m`).
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("cannot read case file {path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("case file {path}: field `{field}`: {reason}")]
+    Parse {
+        path: String,
+        field: String,
+        reason: String,
+    },
+    #[error("case file {path}: field `{field}`: {reason}")]
+    Invalid {
+        path: String,
+        field: String,
+        reason: String,
+    },
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// A short name used in output file names and logs.
+    pub name: String,
+    /// 2 (x along the flume, y up) or 3 (x along, y across, z up).
+    pub dimension: u32,
+    /// The tank: its inner faces are the box `min_m`..`max_m` (one coordinate per dimension).
+    pub domain: Domain,
+    /// Dynamic boundary particles (DBC, Crespo et al. 2007) on the tank's faces.
+    pub walls: Walls,
+    /// The fluid and sediment phases; walls take the density of the first phase.
+    pub phases: Vec<PhaseConfig>,
+    /// Blocks of particles, filled on the dp lattice.
+    pub fluid_blocks: Vec<FluidBlock>,
+    pub numerics: Numerics,
+    /// Gravity in m/s2, one component per dimension (the last one is vertical).
+    pub gravity_m_per_s2: Vec<f64>,
+    pub time: TimeControl,
+    #[serde(default)]
+    pub observations: ObservationConfig,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Domain {
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Walls {
+    /// Number of boundary-particle layers, stacked outwards from each wall face.
+    #[serde(default = "one")]
+    pub layers: u32,
+    /// Whether the top of the tank is closed by a wall too.
+    #[serde(default)]
+    pub closed_top: bool,
+}
+
+fn one() -> u32 {
+    1
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseConfig {
+    pub name: String,
+    /// Rest density of the phase's equation of state, kg/m3.
+    pub rho0_kg_per_m3: f64,
+    /// Dynamic viscosity, Pa s (used by laminar viscosity).
+    #[serde(default = "water_viscosity")]
+    pub viscosity_pa_s: f64,
+}
+
+fn water_viscosity() -> f64 {
+    1.0e-3
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidBlock {
+    /// Name of a phase in `phases`.
+    pub phase: String,
+    /// Lattice points with `min_m < x <= max_m` in every coordinate are filled
+    /// (the lattice is the integer multiples of dp, as in DualSPHysics' GenCase).
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Numerics {
+    /// Initial particle spacing, m.
+    pub dp_m: f64,
+    /// h = coefh * sqrt(dimension) * dp (DualSPHysics convention).
+    #[serde(default = "default_coefh")]
+    pub coefh: f64,
+    /// Courant number of the variable time step.
+    #[serde(default = "default_cfl")]
+    pub cfl: f64,
+    pub sound_speed: SoundSpeed,
+    pub density_diffusion: DensityDiffusion,
+    pub viscosity: Viscosity,
+}
+
+fn default_coefh() -> f64 {
+    1.2
+}
+fn default_cfl() -> f64 {
+    0.2
+}
+
+/// The numerical speed of sound c0 of the Tait equation (Eq. 5): give exactly one of the two.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoundSpeed {
+    /// c0 given directly, m/s.
+    pub c0_m_per_s: Option<f64>,
+    /// c0 = coefsound * sqrt(|g| * H), H the height of the fluid (DualSPHysics' `coefsound`).
+    pub coefsound: Option<f64>,
+}
+
+/// Density diffusion (delta-SPH) in the continuity equation.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case", tag = "method")]
+pub enum DensityDiffusion {
+    None,
+    /// Molteni & Colagrossi 2009.
+    MolteniColagrossi2009 { delta: f64 },
+    /// Molteni-Colagrossi with the hydrostatic correction of Fourtakas et al. 2019.
+    Fourtakas2019 { delta: f64 },
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case", tag = "method")]
+pub enum Viscosity {
+    /// Monaghan 1992 artificial viscosity with coefficient alpha.
+    Artificial { alpha: f64 },
+    /// Laminar viscosity (Morris et al. 1997) with each phase's `viscosity_pa_s`.
+    Laminar,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeControl {
+    /// Simulated time at which a `simulate` run stops, s.
+    pub end_s: f64,
+    /// Interval between observations and snapshots, s.
+    pub output_interval_s: f64,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObservationConfig {
+    /// Free-surface gauges: vertical lines at which the water level is measured.
+    #[serde(default)]
+    pub gauges: Vec<GaugeConfig>,
+    /// Points at which pressure is interpolated (Shepard-corrected kernel sum).
+    #[serde(default)]
+    pub pressure_probes: Vec<ProbeConfig>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GaugeConfig {
+    pub name: String,
+    /// Horizontal position, m: x in 2-D, x and y in 3-D.
+    pub position_m: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeConfig {
+    pub name: String,
+    /// Position, m, one coordinate per dimension.
+    pub position_m: Vec<f64>,
+}
+
+impl Case {
+    pub fn from_path(path: &Path) -> Result<Case, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Case::from_yaml(&text, &path.display().to_string())
+    }
+
+    /// Parses and validates a case; `origin` names the source in error messages.
+    pub fn from_yaml(text: &str, origin: &str) -> Result<Case, ConfigError> {
+        let de = serde_norway::Deserializer::from_str(text);
+        let case: Case = serde_path_to_error::deserialize(de).map_err(|e| {
+            let field = e.path().to_string();
+            ConfigError::Parse {
+                path: origin.to_string(),
+                field: if field == "." {
+                    "(top level)".to_string()
+                } else {
+                    field
+                },
+                reason: {
+                    // serde prefixes the path, which the message already names.
+                    let reason = e.inner().to_string();
+                    let prefix = format!("{}: ", e.path());
+                    reason.strip_prefix(&prefix).unwrap_or(&reason).to_string()
+                },
+            }
+        })?;
+        case.validate()
+            .map_err(|(field, reason)| ConfigError::Invalid {
+                path: origin.to_string(),
+                field,
+                reason,
+            })?;
+        Ok(case)
+    }
+
+    pub fn dim(&self) -> usize {
+        self.dimension as usize
+    }
+
+    /// Smoothing length h, m.
+    pub fn smoothing_length_m(&self) -> f64 {
+        self.numerics.coefh * f64::from(self.dimension).sqrt() * self.numerics.dp_m
+    }
+
+    /// Magnitude of gravity, m/s2.
+    pub fn gravity_magnitude(&self) -> f64 {
+        self.gravity_m_per_s2.iter().map(|g| g * g).sum::<f64>().sqrt()
+    }
+
+    /// Index of a phase by name; phase 0 on the GPU is the wall, so fluid phase k is k + 1.
+    pub fn phase_index(&self, name: &str) -> Option<usize> {
+        self.phases.iter().position(|p| p.name == name)
+    }
+
+    fn validate(&self) -> Result<(), (String, String)> {
+        let err = |field: &str, reason: String| Err((field.to_string(), reason));
+        if self.dimension != 2 && self.dimension != 3 {
+            return err("dimension", format!("must be 2 or 3, got {}", self.dimension));
+        }
+        let d = self.dim();
+        for (field, v) in [
+            ("domain.min_m", &self.domain.min_m),
+            ("domain.max_m", &self.domain.max_m),
+            ("gravity_m_per_s2", &self.gravity_m_per_s2),
+        ] {
+            check_vector(field, v, d)?;
+        }
+        for k in 0..d {
+            if self.domain.max_m[k] <= self.domain.min_m[k] {
+                return err(
+                    "domain.max_m",
+                    format!("component {k} must exceed domain.min_m's"),
+                );
+            }
+        }
+        if self.gravity_m_per_s2[..d - 1].iter().any(|g| *g != 0.0) || self.gravity_m_per_s2[d - 1] >= 0.0 {
+            return err(
+                "gravity_m_per_s2",
+                "must point down the last (vertical) axis, e.g. [0, -9.81]".to_string(),
+            );
+        }
+        if self.walls.layers == 0 || self.walls.layers > 8 {
+            return err("walls.layers", format!("must be 1..=8, got {}", self.walls.layers));
+        }
+        if self.phases.is_empty() {
+            return err("phases", "at least one phase is needed".to_string());
+        }
+        if self.phases.len() > 3 {
+            return err("phases", "at most 3 phases are supported".to_string());
+        }
+        for (i, p) in self.phases.iter().enumerate() {
+            if !(p.rho0_kg_per_m3.is_finite() && p.rho0_kg_per_m3 > 0.0) {
+                return err(&format!("phases[{i}].rho0_kg_per_m3"), "must be a positive number".into());
+            }
+            if !(p.viscosity_pa_s.is_finite() && p.viscosity_pa_s >= 0.0) {
+                return err(&format!("phases[{i}].viscosity_pa_s"), "must be >= 0".into());
+            }
+            if self.phases[..i].iter().any(|q| q.name == p.name) {
+                return err(&format!("phases[{i}].name"), format!("`{}` is defined twice", p.name));
+            }
+        }
+        if self.fluid_blocks.is_empty() {
+            return err("fluid_blocks", "at least one block of fluid is needed".to_string());
+        }
+        for (i, b) in self.fluid_blocks.iter().enumerate() {
+            if self.phase_index(&b.phase).is_none() {
+                return err(
+                    &format!("fluid_blocks[{i}].phase"),
+                    format!("no phase named `{}` in `phases`", b.phase),
+                );
+            }
+            check_vector(&format!("fluid_blocks[{i}].min_m"), &b.min_m, d)?;
+            check_vector(&format!("fluid_blocks[{i}].max_m"), &b.max_m, d)?;
+            for k in 0..d {
+                if b.max_m[k] <= b.min_m[k] {
+                    return err(&format!("fluid_blocks[{i}].max_m"), format!("component {k} must exceed min_m's"));
+                }
+                if b.min_m[k] < self.domain.min_m[k] - 1e-9 || b.max_m[k] > self.domain.max_m[k] + 1e-9 {
+                    return err(&format!("fluid_blocks[{i}]"), "must lie inside the domain".to_string());
+                }
+            }
+        }
+        let n = &self.numerics;
+        let extent = (0..d).map(|k| self.domain.max_m[k] - self.domain.min_m[k]).fold(f64::MAX, f64::min);
+        if !(n.dp_m.is_finite() && n.dp_m > 0.0 && n.dp_m < extent / 4.0) {
+            return err("numerics.dp_m", format!("must be positive and below a quarter of the smallest tank size ({extent} m), got {}", n.dp_m));
+        }
+        if !(n.coefh.is_finite() && (0.5..=3.0).contains(&n.coefh)) {
+            return err("numerics.coefh", format!("must be in 0.5..=3, got {}", n.coefh));
+        }
+        if !(n.cfl.is_finite() && n.cfl > 0.0 && n.cfl <= 1.0) {
+            return err("numerics.cfl", format!("must be in (0, 1], got {}", n.cfl));
+        }
+        match (n.sound_speed.c0_m_per_s, n.sound_speed.coefsound) {
+            (Some(c), None) if !(c.is_finite() && c > 0.0) => {
+                return err("numerics.sound_speed.c0_m_per_s", format!("must be positive, got {c}"));
+            }
+            (None, Some(c)) if !(c.is_finite() && c > 0.0) => {
+                return err("numerics.sound_speed.coefsound", format!("must be positive, got {c}"));
+            }
+            (Some(_), Some(_)) | (None, None) => {
+                return err("numerics.sound_speed", "give exactly one of c0_m_per_s and coefsound".into());
+            }
+            _ => {}
+        }
+        match n.density_diffusion {
+            DensityDiffusion::MolteniColagrossi2009 { delta } | DensityDiffusion::Fourtakas2019 { delta }
+                if !(delta.is_finite() && (0.0..=1.0).contains(&delta)) =>
+            {
+                return err("numerics.density_diffusion.delta", format!("must be in 0..=1, got {delta}"));
+            }
+            _ => {}
+        }
+        if let Viscosity::Artificial { alpha } = n.viscosity
+            && !(alpha.is_finite() && (0.0..=10.0).contains(&alpha))
+        {
+            return err("numerics.viscosity.alpha", format!("must be in 0..=10, got {alpha}"));
+        }
+        let t = &self.time;
+        if !(t.end_s.is_finite() && t.end_s > 0.0) {
+            return err("time.end_s", "must be positive".into());
+        }
+        if !(t.output_interval_s.is_finite() && t.output_interval_s > 0.0) {
+            return err("time.output_interval_s", "must be positive".into());
+        }
+        for (i, g) in self.observations.gauges.iter().enumerate() {
+            check_vector(&format!("observations.gauges[{i}].position_m"), &g.position_m, d - 1)?;
+            for k in 0..d - 1 {
+                if !(self.domain.min_m[k]..=self.domain.max_m[k]).contains(&g.position_m[k]) {
+                    return err(&format!("observations.gauges[{i}].position_m"), "must lie inside the domain".into());
+                }
+            }
+        }
+        for (i, p) in self.observations.pressure_probes.iter().enumerate() {
+            check_vector(&format!("observations.pressure_probes[{i}].position_m"), &p.position_m, d)?;
+        }
+        Ok(())
+    }
+}
+
+fn check_vector(field: &str, v: &[f64], len: usize) -> Result<(), (String, String)> {
+    if v.len() != len {
+        return Err((field.to_string(), format!("needs {len} components, got {}", v.len())));
+    }
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err((field.to_string(), "components must be finite numbers".to_string()));
+    }
+    Ok(())
+}

@@ -1,0 +1,9 @@
+//! wgpu plumbing: the device, buffers, shader composition and the stage shape.
+
+pub mod buffers;
+pub mod context;
+pub mod params;
+pub mod shader;
+pub mod stage;
+
+pub use context::{AdapterSummary, GpuContext, GpuError};

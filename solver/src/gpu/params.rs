@@ -1,0 +1,89 @@
+//! `SimParams`, the uniform every stage reads; mirrors `shaders/common/params.wgsl`
+//! (`shaders_validate` checks the offsets against naga's layout of the WGSL struct).
+
+use bytemuck::{Pod, Zeroable};
+
+pub const MAX_PHASES: usize = 4;
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct PhaseParams {
+    pub rho0: f32,
+    pub mass: f32,
+    pub mu: f32,
+    /// 1.0 for fluid, 0.0 for DBC wall particles.
+    pub mobile: f32,
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SimParams {
+    pub n_particles: u32,
+    pub n_cells: u32,
+    pub viscosity_mode: u32,
+    pub diffusion_mode: u32,
+    pub grid_dims: [u32; 4],
+    pub grid_origin: [f32; 4],
+    pub gravity: [f32; 4],
+    pub h: f32,
+    pub kernel_ad: f32,
+    pub c0: f32,
+    pub eta2: f32,
+    pub delta_h_c0: f32,
+    pub alpha: f32,
+    pub cfl: f32,
+    pub dt_visc: f32,
+    pub dt_min: f32,
+    pub rho_ratio_max: f32,
+    pub vertical_axis: u32,
+    pub n_probes: u32,
+    pub phases: [PhaseParams; MAX_PHASES],
+    pub tait_b: [f32; 4],
+}
+
+pub const VISCOSITY_ARTIFICIAL: u32 = 0;
+pub const VISCOSITY_LAMINAR: u32 = 1;
+pub const DIFFUSION_NONE: u32 = 0;
+pub const DIFFUSION_MOLTENI: u32 = 1;
+pub const DIFFUSION_FOURTAKAS: u32 = 2;
+
+/// Mirrors `StepState` in `shaders/common/step_state.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct StepState {
+    pub dt: f32,
+    pub t_rel: f32,
+    pub t_target: f32,
+    pub steps: u32,
+    pub dt_min_bits: u32,
+    pub status: u32,
+    pub last_dt: f32,
+    pub pad: u32,
+}
+
+/// Mirrors `Extremes` in `shaders/stages/observe_reduce.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct Extremes {
+    pub front_key: u32,
+    pub max_speed_bits: u32,
+    pub max_rho_err_bits: u32,
+    pub fluid_count: u32,
+}
+
+/// Inverse of the shader's `order_key`.
+pub fn from_order_key(k: u32) -> f32 {
+    if k & 0x8000_0000 != 0 {
+        f32::from_bits(k & 0x7fff_ffff)
+    } else {
+        f32::from_bits(!k)
+    }
+}
+
+/// Mirrors `ScanInfo` in `shaders/stages/prefix_sum.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct ScanInfo {
+    pub n: u32,
+    pub pad: [u32; 3],
+}

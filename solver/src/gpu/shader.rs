@@ -1,0 +1,47 @@
+//! WGSL sources, embedded in the binary, and their composition.
+//!
+//! A stage file (`shaders/stages/*.wgsl`) names the import-only modules it needs in its
+//! wrapper's `IMPORTS`; composition prepends them in the order given. Nothing is substituted
+//! inside any source, so each composed module is the plain concatenation of files on disk.
+
+/// Every WGSL file of the solver, by its path under `shaders/`.
+pub const SOURCES: &[(&str, &str)] = &[
+    ("common/params.wgsl", include_str!("../../../shaders/common/params.wgsl")),
+    ("common/kernel.wgsl", include_str!("../../../shaders/common/kernel.wgsl")),
+    ("common/eos.wgsl", include_str!("../../../shaders/common/eos.wgsl")),
+    ("common/grid.wgsl", include_str!("../../../shaders/common/grid.wgsl")),
+    ("common/neighbours.wgsl", include_str!("../../../shaders/common/neighbours.wgsl")),
+    ("common/step_state.wgsl", include_str!("../../../shaders/common/step_state.wgsl")),
+    ("stages/grid_clear.wgsl", include_str!("../../../shaders/stages/grid_clear.wgsl")),
+    ("stages/grid_count.wgsl", include_str!("../../../shaders/stages/grid_count.wgsl")),
+    ("stages/prefix_sum.wgsl", include_str!("../../../shaders/stages/prefix_sum.wgsl")),
+    ("stages/grid_scatter.wgsl", include_str!("../../../shaders/stages/grid_scatter.wgsl")),
+    ("stages/cell_sort.wgsl", include_str!("../../../shaders/stages/cell_sort.wgsl")),
+    ("stages/reorder.wgsl", include_str!("../../../shaders/stages/reorder.wgsl")),
+    ("stages/forces_wcsph.wgsl", include_str!("../../../shaders/stages/forces_wcsph.wgsl")),
+    ("stages/dt_update.wgsl", include_str!("../../../shaders/stages/dt_update.wgsl")),
+    ("stages/integrate_symplectic.wgsl", include_str!("../../../shaders/stages/integrate_symplectic.wgsl")),
+    ("stages/probe_interpolate.wgsl", include_str!("../../../shaders/stages/probe_interpolate.wgsl")),
+    ("stages/observe_reduce.wgsl", include_str!("../../../shaders/stages/observe_reduce.wgsl")),
+];
+
+pub fn source(path: &str) -> &'static str {
+    SOURCES
+        .iter()
+        .find(|(p, _)| *p == path)
+        .map(|(_, s)| *s)
+        .unwrap_or_else(|| panic!("shader {path} is not embedded in gpu::shader::SOURCES"))
+}
+
+/// The composed WGSL of a stage: its imports in order, then the stage itself.
+pub fn compose(imports: &[&str], stage: &str) -> String {
+    let mut out = String::new();
+    for path in imports.iter().chain(std::iter::once(&stage)) {
+        out.push_str("// ---- ");
+        out.push_str(path);
+        out.push('\n');
+        out.push_str(source(path));
+        out.push('\n');
+    }
+    out
+}

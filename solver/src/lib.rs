@@ -1,0 +1,20 @@
+//! flume-solver: a GPU-resident weakly compressible SPH solver on wgpu (WGSL compute shaders),
+//! the model of the flume digital twin. It knows nothing of ROS, DDS, MCAP or wall-clock time:
+//! it takes a case and gives observations.
+//!
+//! Start at `pipeline.rs`: its step lists every stage; each stage name leads to its WGSL file
+//! in `shaders/stages/`, its spec in `stages.rs` and its CPU oracle in `physics`.
+
+pub mod case;
+pub mod config;
+pub mod gpu;
+pub mod observe;
+pub mod physics;
+pub mod pipeline;
+pub mod simulation;
+pub mod stages;
+
+pub use config::{Case, ConfigError};
+pub use gpu::{GpuContext, GpuError};
+pub use observe::Observations;
+pub use simulation::{Health, Simulation, SolverError};

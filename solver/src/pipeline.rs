@@ -1,0 +1,267 @@
+//! One SPH step as a fixed sequence of compute dispatches (start here).
+//!
+//! `SphPipeline` holds the compiled stages and no particle state; `GpuBuffers` holds the
+//! state; `Bindings` ties the two together once, at setup. A step never reads back.
+
+use crate::gpu::buffers::storage;
+use crate::gpu::params::{ScanInfo, StepState};
+use crate::gpu::stage::{Stage, groups};
+use crate::gpu::{GpuContext, GpuError};
+use crate::stages::{self, PREFIX_SUM_BLOCK};
+
+pub struct SphPipeline {
+    grid_clear: Stage,
+    grid_count: Stage,
+    prefix_sum: Stage,
+    grid_scatter: Stage,
+    cell_sort: Stage,
+    reorder: Stage,
+    forces_predict: Stage,
+    forces_correct: Stage,
+    dt_update: Stage,
+    integrate: Stage,
+    probe_interpolate: Stage,
+    observe_reduce: Stage,
+}
+
+impl SphPipeline {
+    pub fn new(gpu: &GpuContext, dim: u32) -> SphPipeline {
+        let d = &gpu.device;
+        let rows = if dim == 2 { 3.0 } else { 9.0 };
+        let stencil = [("STENCIL_ROWS", rows)];
+        SphPipeline {
+            grid_clear: Stage::new(d, &stages::GRID_CLEAR, &[]),
+            grid_count: Stage::new(d, &stages::GRID_COUNT, &[]),
+            prefix_sum: Stage::new(d, &stages::PREFIX_SUM, &[]),
+            grid_scatter: Stage::new(d, &stages::GRID_SCATTER, &[]),
+            cell_sort: Stage::new(d, &stages::CELL_SORT, &[]),
+            reorder: Stage::new(d, &stages::REORDER, &[]),
+            forces_predict: Stage::new(d, &stages::FORCES_WCSPH, &[stencil[0], ("REDUCE_DT", 1.0)]),
+            forces_correct: Stage::new(d, &stages::FORCES_WCSPH, &[stencil[0], ("REDUCE_DT", 0.0)]),
+            dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
+            integrate: Stage::new(d, &stages::INTEGRATE_SYMPLECTIC, &[]),
+            probe_interpolate: Stage::new(d, &stages::PROBE_INTERPOLATE, &stencil),
+            observe_reduce: Stage::new(d, &stages::OBSERVE_REDUCE, &[]),
+        }
+    }
+}
+
+/// Particle state and scratch, all resident on the GPU. `a` is the state between steps,
+/// `b` its copy in cell order at the start of a step, `c` the half-step state.
+pub struct GpuBuffers {
+    pub params: wgpu::Buffer,
+    pub a: StateBuffers,
+    pub b: StateBuffers,
+    pub c_positions: wgpu::Buffer,
+    pub c_vel_rho: wgpu::Buffer,
+    pub forces: wgpu::Buffer,
+    pub cell_of: wgpu::Buffer,
+    pub cell_starts: wgpu::Buffer,
+    pub cell_cursor: wgpu::Buffer,
+    pub sorted_index: wgpu::Buffer,
+    /// Per scan level: its uniform and the block sums it writes.
+    pub scan_levels: Vec<(wgpu::Buffer, wgpu::Buffer, u32)>,
+    pub state: wgpu::Buffer,
+    pub probe_points: wgpu::Buffer,
+    pub probe_sums: wgpu::Buffer,
+    pub extremes: wgpu::Buffer,
+}
+
+pub struct StateBuffers {
+    pub positions: wgpu::Buffer,
+    pub vel_rho: wgpu::Buffer,
+    pub ids: wgpu::Buffer,
+}
+
+/// Bytes per particle and per cell of `GpuBuffers`, for the up-front size check.
+pub const VEC4_BYTES: u64 = 16;
+
+impl GpuBuffers {
+    /// Checks every large buffer against the adapter's limits before anything is allocated.
+    pub fn check_limits(gpu: &GpuContext, n_particles: u64, n_cells: u64) -> Result<(), GpuError> {
+        gpu.check_storage_size("positions", n_particles * VEC4_BYTES)?;
+        gpu.check_storage_size("cell_starts", (n_cells + 1) * 4)?;
+        let max_groups = u64::from(gpu.limits.max_compute_workgroups_per_dimension);
+        if n_particles.div_ceil(64) > max_groups || (n_cells + 1).div_ceil(128) > max_groups {
+            return Err(GpuError::TooLarge {
+                buffer: "dispatch size".to_string(),
+                needed_mib: (n_particles * VEC4_BYTES) as f64 / 1048576.0,
+                limit_mib: (max_groups * 64 * VEC4_BYTES) as f64 / 1048576.0,
+                adapter: gpu.adapter.name.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    pub fn new(
+        gpu: &GpuContext,
+        params: wgpu::Buffer,
+        a: StateBuffers,
+        n_cells: u32,
+        n_probes: u32,
+    ) -> GpuBuffers {
+        let n = a.positions.size() / VEC4_BYTES;
+        let b = StateBuffers {
+            positions: storage(gpu, "b.positions", n * VEC4_BYTES),
+            vel_rho: storage(gpu, "b.vel_rho", n * VEC4_BYTES),
+            ids: storage(gpu, "b.ids", n * 4),
+        };
+        let mut scan_levels = Vec::new();
+        let mut len = n_cells + 1;
+        loop {
+            let blocks = len.div_ceil(PREFIX_SUM_BLOCK);
+            let info = crate::gpu::buffers::uniform_init(gpu, "scan info", &ScanInfo { n: len, pad: [0; 3] });
+            scan_levels.push((info, storage(gpu, "scan block sums", u64::from(blocks) * 4), len));
+            if blocks == 1 {
+                break;
+            }
+            len = blocks;
+        }
+        GpuBuffers {
+            params,
+            b,
+            c_positions: storage(gpu, "c.positions", n * VEC4_BYTES),
+            c_vel_rho: storage(gpu, "c.vel_rho", n * VEC4_BYTES),
+            forces: storage(gpu, "forces", n * VEC4_BYTES),
+            cell_of: storage(gpu, "cell_of", n * 4),
+            cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),
+            cell_cursor: storage(gpu, "cell_cursor", u64::from(n_cells + 1) * 4),
+            sorted_index: storage(gpu, "sorted_index", n * 4),
+            scan_levels,
+            state: storage(gpu, "step state", std::mem::size_of::<StepState>() as u64),
+            probe_points: storage(gpu, "probe points", u64::from(n_probes.max(1)) * VEC4_BYTES),
+            probe_sums: storage(gpu, "probe sums", u64::from(n_probes.max(1)) * 8),
+            extremes: storage(gpu, "extremes", 16),
+            a,
+        }
+    }
+}
+
+pub struct Bindings {
+    grid_clear: wgpu::BindGroup,
+    grid_count: wgpu::BindGroup,
+    scan: Vec<(wgpu::BindGroup, u32)>,
+    grid_scatter: wgpu::BindGroup,
+    cell_sort: wgpu::BindGroup,
+    reorder: wgpu::BindGroup,
+    forces_predict: wgpu::BindGroup,
+    forces_correct: wgpu::BindGroup,
+    dt_update: wgpu::BindGroup,
+    integrate: wgpu::BindGroup,
+    probe_interpolate: wgpu::BindGroup,
+    observe_reduce: wgpu::BindGroup,
+    n_particles: u32,
+    n_cells: u32,
+    n_probes: u32,
+}
+
+impl SphPipeline {
+    pub fn bind(&self, gpu: &GpuContext, g: &GpuBuffers, n_particles: u32, n_cells: u32, n_probes: u32) -> Bindings {
+        let d = &gpu.device;
+        let mut scan = Vec::new();
+        let mut data = &g.cell_starts;
+        for (info, sums, len) in &g.scan_levels {
+            scan.push((self.prefix_sum.bind(d, &[info, data, sums]), *len));
+            data = sums;
+        }
+        Bindings {
+            grid_clear: self.grid_clear.bind(d, &[&g.params, &g.cell_starts, &g.cell_cursor]),
+            grid_count: self.grid_count.bind(d, &[&g.params, &g.a.positions, &g.cell_of, &g.cell_starts]),
+            scan,
+            grid_scatter: self.grid_scatter.bind(
+                d,
+                &[&g.params, &g.cell_of, &g.cell_starts, &g.cell_cursor, &g.sorted_index],
+            ),
+            cell_sort: self.cell_sort.bind(d, &[&g.params, &g.cell_starts, &g.a.ids, &g.sorted_index]),
+            reorder: self.reorder.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.sorted_index,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b.ids,
+                ],
+            ),
+            forces_predict: self.forces_predict.bind(
+                d,
+                &[&g.params, &g.b.positions, &g.b.vel_rho, &g.cell_starts, &g.forces, &g.state],
+            ),
+            forces_correct: self.forces_correct.bind(
+                d,
+                &[&g.params, &g.c_positions, &g.c_vel_rho, &g.cell_starts, &g.forces, &g.state],
+            ),
+            dt_update: self.dt_update.bind(d, &[&g.params, &g.state]),
+            integrate: self.integrate.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.forces,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b.ids,
+                    &g.c_positions,
+                    &g.c_vel_rho,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                ],
+            ),
+            probe_interpolate: self.probe_interpolate.bind(
+                d,
+                &[&g.params, &g.b.positions, &g.b.vel_rho, &g.cell_starts, &g.probe_points, &g.probe_sums],
+            ),
+            observe_reduce: self.observe_reduce.bind(d, &[&g.params, &g.a.positions, &g.a.vel_rho, &g.extremes]),
+            n_particles,
+            n_cells,
+            n_probes,
+        }
+    }
+
+    /// Neighbour search: counting sort of state `a` into cells, copied in cell order into `b`.
+    pub fn record_sort(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
+        let n = b.n_particles;
+        let cells = b.n_cells + 1;
+        self.grid_clear.record(pass, 0, &b.grid_clear, groups(cells, 128));
+        self.grid_count.record(pass, 0, &b.grid_count, groups(n, 128));
+        // Exclusive scan of the counts into cell starts, level by level, then added back down.
+        for (bind, len) in &b.scan {
+            self.prefix_sum.record(pass, 0, bind, groups(*len, PREFIX_SUM_BLOCK));
+        }
+        for (bind, len) in b.scan.iter().rev().skip(1) {
+            self.prefix_sum.record(pass, 1, bind, groups(*len, PREFIX_SUM_BLOCK));
+        }
+        self.grid_scatter.record(pass, 0, &b.grid_scatter, groups(n, 128));
+        self.cell_sort.record(pass, 0, &b.cell_sort, groups(b.n_cells, 128));
+        self.reorder.record(pass, 0, &b.reorder, groups(n, 128));
+    }
+
+    /// One symplectic step (DualSPHysics): sort, forces at n, dt, predictor to n + 1/2,
+    /// forces at n + 1/2, corrector to n + 1.
+    pub fn record_step(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
+        let n = b.n_particles;
+        self.record_sort(pass, b);
+        self.forces_predict.record(pass, 0, &b.forces_predict, groups(n, 64));
+        self.dt_update.record(pass, 0, &b.dt_update, 1);
+        self.integrate.record(pass, 0, &b.integrate, groups(n, 128));
+        self.forces_correct.record(pass, 0, &b.forces_correct, groups(n, 64));
+        self.integrate.record(pass, 1, &b.integrate, groups(n, 128));
+    }
+
+    /// Forces at the current state only (no integration): for tests against the CPU oracle.
+    pub fn record_forces(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
+        self.record_sort(pass, b);
+        self.forces_predict.record(pass, 0, &b.forces_predict, groups(b.n_particles, 64));
+    }
+
+    /// Observation passes: probe sums on the sorted state and the whole-state maxima.
+    pub fn record_observe(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
+        self.record_sort(pass, b);
+        self.probe_interpolate.record(pass, 0, &b.probe_interpolate, groups(b.n_probes, 64));
+        self.observe_reduce.record(pass, 0, &b.observe_reduce, groups(b.n_particles, 128));
+    }
+}

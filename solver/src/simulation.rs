@@ -1,0 +1,438 @@
+//! The solver's public face: a case in, `advance_to(t)` and observations out.
+//!
+//! Absolute time is kept here in f64; the GPU only sees the time since the start of the
+//! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s).
+
+use crate::case::{self, Derived, Particles, WALL_PHASE};
+use crate::config::{Case, DensityDiffusion, Viscosity};
+use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
+use crate::gpu::params::*;
+use crate::gpu::{GpuContext, GpuError};
+use crate::observe::{self, Observations};
+use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
+use std::sync::Arc;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SolverError {
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error("the case has {0} particles; the solver's indices are 32-bit")]
+    TooManyParticles(u64),
+    #[error("simulation blew up at t = {time_s:.6} s (step {step}): {health}")]
+    BlowUp { time_s: f64, step: u64, health: Health },
+    #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
+    TimeGoesBack { target_s: f64, now_s: f64 },
+}
+
+/// Health flags raised on the GPU by the step loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Health(pub u32);
+
+impl Health {
+    pub const NON_FINITE: u32 = 1;
+    pub const DENSITY_RUNAWAY: u32 = 2;
+    pub const DT_COLLAPSE: u32 = 4;
+    pub fn is_ok(self) -> bool {
+        self.0 == 0
+    }
+}
+
+impl std::fmt::Display for Health {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut parts = Vec::new();
+        if self.0 & Self::NON_FINITE != 0 {
+            parts.push("a particle has a NaN or infinite position, velocity or density");
+        }
+        if self.0 & Self::DENSITY_RUNAWAY != 0 {
+            parts.push("a density left the weakly compressible range");
+        }
+        if self.0 & Self::DT_COLLAPSE != 0 {
+            parts.push("the stable time step collapsed");
+        }
+        if parts.is_empty() {
+            parts.push("healthy");
+        }
+        write!(f, "{}", parts.join("; "))
+    }
+}
+
+/// Largest number of steps recorded into one submission.
+const MAX_STEPS_PER_SUBMIT: u32 = 400;
+/// |rho / rho0 - 1| above which a density is a runaway (weakly compressible: about 1 %).
+const RHO_RATIO_MAX: f32 = 0.5;
+
+pub struct Simulation {
+    gpu: Arc<GpuContext>,
+    case: Case,
+    derived: Derived,
+    pipeline: SphPipeline,
+    buffers: GpuBuffers,
+    bindings: Bindings,
+    params: SimParams,
+    probes: observe::ProbeLayout,
+    time_s: f64,
+    steps: u64,
+    last_dt_s: f64,
+    initial_particles: Particles,
+}
+
+/// Grid of cells of size 2h covering the tank, its walls and a margin above it.
+fn grid_for(case: &Case, h: f64) -> ([u32; 4], [f32; 4]) {
+    let d = case.dim();
+    let cell = 2.0 * h;
+    let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
+    let mut dims = [1u32; 4];
+    let mut origin = [0.0f32; 4];
+    for k in 0..d {
+        let lo = case.domain.min_m[k] - margin;
+        let mut hi = case.domain.max_m[k] + margin;
+        if k == d - 1 {
+            // Room above the tank for splashes; particles above the grid still live in its top row.
+            hi += 0.25 * (case.domain.max_m[k] - case.domain.min_m[k]);
+        }
+        dims[k] = ((hi - lo) / cell).ceil().max(1.0) as u32;
+        origin[k] = lo as f32;
+    }
+    dims[3] = dims[0] * dims[1] * dims[2];
+    origin[3] = (1.0 / cell) as f32;
+    (dims, origin)
+}
+
+impl Simulation {
+    pub fn new(gpu: Arc<GpuContext>, case: &Case) -> Result<Simulation, SolverError> {
+        let derived = case::derive(case);
+        let (grid_dims, grid_origin) = grid_for(case, derived.h);
+        let n_cells = u64::from(grid_dims[3]);
+        let count = case::count(case);
+        if count >= u64::from(u32::MAX / 2) {
+            return Err(SolverError::TooManyParticles(count));
+        }
+        GpuBuffers::check_limits(&gpu, count, n_cells)?;
+        let particles = case::generate(case, &derived);
+        Self::with_particles(gpu, case, derived, particles, (grid_dims, grid_origin))
+    }
+
+    fn with_particles(
+        gpu: Arc<GpuContext>,
+        case: &Case,
+        derived: Derived,
+        particles: Particles,
+        (grid_dims, grid_origin): ([u32; 4], [f32; 4]),
+    ) -> Result<Simulation, SolverError> {
+        let n = particles.len() as u32;
+        let probes = observe::ProbeLayout::new(case, derived.h);
+        let params = sim_params(case, &derived, n, grid_dims, grid_origin, probes.points.len() as u32);
+        let a = StateBuffers {
+            positions: storage_init(&gpu, "a.positions", &particles.positions),
+            vel_rho: storage_init(&gpu, "a.vel_rho", &particles.vel_rho),
+            ids: storage_init(&gpu, "a.ids", &particles.ids),
+        };
+        let buffers = GpuBuffers::new(
+            &gpu,
+            uniform_init(&gpu, "params", &params),
+            a,
+            params.n_cells,
+            params.n_probes,
+        );
+        gpu.queue
+            .write_buffer(&buffers.probe_points, 0, bytemuck::cast_slice(&probes.points));
+        let pipeline = SphPipeline::new(&gpu, case.dimension);
+        let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
+        Ok(Simulation {
+            gpu,
+            case: case.clone(),
+            derived,
+            pipeline,
+            buffers,
+            bindings,
+            params,
+            probes,
+            time_s: 0.0,
+            steps: 0,
+            last_dt_s: 0.0,
+            initial_particles: particles,
+        })
+    }
+
+    pub fn case(&self) -> &Case {
+        &self.case
+    }
+    pub fn derived(&self) -> &Derived {
+        &self.derived
+    }
+    pub fn gpu(&self) -> &GpuContext {
+        &self.gpu
+    }
+    pub fn particle_count(&self) -> usize {
+        self.initial_particles.len()
+    }
+    pub fn fluid_count(&self) -> usize {
+        (0..self.initial_particles.len())
+            .filter(|&i| self.initial_particles.phase(i) != WALL_PHASE)
+            .count()
+    }
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    pub fn last_dt_s(&self) -> f64 {
+        self.last_dt_s
+    }
+    pub fn initial_particles(&self) -> &Particles {
+        &self.initial_particles
+    }
+
+    /// Runs the GPU step loop until simulated time reaches `target_s` (exactly).
+    /// Steps are recorded many to a submission; the host reads back only between submissions.
+    pub fn advance_to(&mut self, target_s: f64) -> Result<(), SolverError> {
+        if target_s < self.time_s {
+            return Err(SolverError::TimeGoesBack {
+                target_s,
+                now_s: self.time_s,
+            });
+        }
+        let chunk_start = self.time_s;
+        let rel_target = (target_s - chunk_start) as f32;
+        if rel_target <= 0.0 {
+            return Ok(());
+        }
+        let init = StepState {
+            dt: 0.0,
+            t_rel: 0.0,
+            t_target: rel_target,
+            steps: 0,
+            dt_min_bits: f32::MAX.to_bits(),
+            status: 0,
+            last_dt: self.last_dt_s as f32,
+            pad: 0,
+        };
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
+        let mut done_steps = 0u32;
+        let mut batch = 8u32;
+        loop {
+            self.submit_steps(batch);
+            let state = self.read_state()?;
+            self.steps += u64::from(state.steps - done_steps);
+            done_steps = state.steps;
+            self.last_dt_s = f64::from(state.last_dt);
+            let health = Health(state.status);
+            if !health.is_ok() {
+                self.time_s = chunk_start + f64::from(state.t_rel);
+                return Err(SolverError::BlowUp {
+                    time_s: self.time_s,
+                    step: self.steps,
+                    health,
+                });
+            }
+            if state.t_rel >= state.t_target {
+                self.time_s = target_s;
+                return Ok(());
+            }
+            self.time_s = chunk_start + f64::from(state.t_rel);
+            let remaining = f64::from(state.t_target - state.t_rel);
+            let estimate = if state.last_dt > 0.0 {
+                (remaining / f64::from(state.last_dt)).ceil() as u32 + 1
+            } else {
+                batch * 2
+            };
+            batch = estimate.clamp(1, MAX_STEPS_PER_SUBMIT);
+        }
+    }
+
+    fn submit_steps(&self, steps: u32) {
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("steps") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("sph steps"),
+                timestamp_writes: None,
+            });
+            for _ in 0..steps {
+                self.pipeline.record_step(&mut pass, &self.bindings);
+            }
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+    }
+
+    fn read_state(&self) -> Result<StepState, GpuError> {
+        let bytes = read_buffers(&self.gpu, &[(&self.buffers.state, std::mem::size_of::<StepState>() as u64)])?;
+        Ok(bytemuck::pod_read_unaligned(&bytes[0]))
+    }
+
+    /// The particles as they are now, in id order (index i holds the particle generated i-th).
+    pub fn read_particles(&self) -> Result<Particles, SolverError> {
+        let n = self.particle_count() as u64;
+        let a = &self.buffers.a;
+        let raw = read_buffers(&self.gpu, &[(&a.positions, n * 16), (&a.vel_rho, n * 16), (&a.ids, n * 4)])?;
+        let positions: Vec<[f32; 4]> = cast_vec(&raw[0]);
+        let vel_rho: Vec<[f32; 4]> = cast_vec(&raw[1]);
+        let ids: Vec<u32> = cast_vec(&raw[2]);
+        let mut out = Particles {
+            positions: vec![[0.0; 4]; n as usize],
+            vel_rho: vec![[0.0; 4]; n as usize],
+            ids: (0..n as u32).collect(),
+        };
+        for (k, &id) in ids.iter().enumerate() {
+            let i = id as usize;
+            if i < out.positions.len() {
+                out.positions[i] = positions[k];
+                out.vel_rho[i] = vel_rho[k];
+            }
+        }
+        Ok(out)
+    }
+
+    /// Forces and density rates (x, y, z acceleration, d rho/dt) of the current state, in id
+    /// order, without advancing: the GPU side of the force-stage test.
+    pub fn compute_forces(&self) -> Result<Vec<[f32; 4]>, SolverError> {
+        self.gpu.queue.write_buffer(
+            &self.buffers.state,
+            16,
+            bytemuck::bytes_of(&f32::MAX.to_bits()),
+        );
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.pipeline.record_forces(&mut pass, &self.bindings);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let n = self.particle_count() as u64;
+        let raw = read_buffers(&self.gpu, &[(&self.buffers.forces, n * 16), (&self.buffers.b.ids, n * 4)])?;
+        let forces: Vec<[f32; 4]> = cast_vec(&raw[0]);
+        let ids: Vec<u32> = cast_vec(&raw[1]);
+        let mut out = vec![[0.0; 4]; n as usize];
+        for (k, &id) in ids.iter().enumerate() {
+            if let Some(slot) = out.get_mut(id as usize) {
+                *slot = forces[k];
+            }
+        }
+        Ok(out)
+    }
+
+    /// The cell list of the current state: (cell starts, particle ids in sorted order).
+    pub fn cell_list(&self) -> Result<(Vec<u32>, Vec<u32>), SolverError> {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.pipeline.record_sort(&mut pass, &self.bindings);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let n = self.particle_count() as u64;
+        let cells = u64::from(self.params.n_cells) + 1;
+        let raw = read_buffers(&self.gpu, &[(&self.buffers.cell_starts, cells * 4), (&self.buffers.b.ids, n * 4)])?;
+        Ok((cast_vec(&raw[0]), cast_vec(&raw[1])))
+    }
+
+    pub fn params(&self) -> &SimParams {
+        &self.params
+    }
+
+    /// Gauges, probes, front and health at the current time.
+    pub fn observe(&self) -> Result<Observations, SolverError> {
+        let reset = Extremes {
+            front_key: 0,
+            max_speed_bits: 0,
+            max_rho_err_bits: 0,
+            fluid_count: 0,
+        };
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.extremes, 0, bytemuck::bytes_of(&reset));
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.pipeline.record_observe(&mut pass, &self.bindings);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let raw = read_buffers(
+            &self.gpu,
+            &[
+                (&self.buffers.probe_sums, self.probes.points.len() as u64 * 8),
+                (&self.buffers.extremes, 16),
+            ],
+        )?;
+        let sums: Vec<[f32; 2]> = cast_vec(&raw[0]);
+        let ext: Extremes = bytemuck::pod_read_unaligned(&raw[1]);
+        Ok(self.probes.observations(
+            self.time_s,
+            self.steps,
+            self.last_dt_s,
+            &sums,
+            &ext,
+        ))
+    }
+}
+
+fn sim_params(case: &Case, derived: &Derived, n: u32, grid_dims: [u32; 4], grid_origin: [f32; 4], n_probes: u32) -> SimParams {
+    let d = case.dim();
+    let h = derived.h;
+    let mut gravity = [0.0f32; 4];
+    for k in 0..d {
+        gravity[k] = case.gravity_m_per_s2[k] as f32;
+    }
+    gravity[3] = (-case.gravity_m_per_s2[d - 1]) as f32;
+    let mut phases = [PhaseParams {
+        rho0: 1000.0,
+        mass: 0.0,
+        mu: 0.0,
+        mobile: 0.0,
+    }; MAX_PHASES];
+    let mut tait_b = [1.0f32; 4];
+    let mut dt_visc = f64::from(f32::MAX);
+    for (k, p) in derived.phases.iter().enumerate() {
+        phases[k] = PhaseParams {
+            rho0: p.rho0 as f32,
+            mass: p.mass as f32,
+            mu: p.viscosity_pa_s as f32,
+            mobile: if p.mobile { 1.0 } else { 0.0 },
+        };
+        tait_b[k] = (derived.c0 * derived.c0 * p.rho0 / 7.0) as f32;
+        if p.mobile && p.viscosity_pa_s > 0.0 && matches!(case.numerics.viscosity, Viscosity::Laminar) {
+            dt_visc = dt_visc.min(0.125 * h * h * p.rho0 / p.viscosity_pa_s);
+        }
+    }
+    let (viscosity_mode, alpha) = match case.numerics.viscosity {
+        Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha),
+        Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0),
+    };
+    let (diffusion_mode, delta) = match case.numerics.density_diffusion {
+        DensityDiffusion::None => (DIFFUSION_NONE, 0.0),
+        DensityDiffusion::MolteniColagrossi2009 { delta } => (DIFFUSION_MOLTENI, delta),
+        DensityDiffusion::Fourtakas2019 { delta } => (DIFFUSION_FOURTAKAS, delta),
+    };
+    let kernel_ad = if d == 2 {
+        7.0 / (4.0 * std::f64::consts::PI * h * h)
+    } else {
+        21.0 / (16.0 * std::f64::consts::PI * h * h * h)
+    };
+    SimParams {
+        n_particles: n,
+        n_cells: grid_dims[3],
+        viscosity_mode,
+        diffusion_mode,
+        grid_dims: [grid_dims[0], grid_dims[1], grid_dims[2], 0],
+        grid_origin,
+        gravity,
+        h: h as f32,
+        kernel_ad: kernel_ad as f32,
+        c0: derived.c0 as f32,
+        eta2: (0.01 * h * h) as f32,
+        delta_h_c0: (delta * h * derived.c0) as f32,
+        alpha: alpha as f32,
+        cfl: case.numerics.cfl as f32,
+        dt_visc: dt_visc as f32,
+        // A step a million times below the acoustic one means the state has gone bad.
+        dt_min: (1e-6 * h / derived.c0) as f32,
+        rho_ratio_max: RHO_RATIO_MAX,
+        vertical_axis: (d - 1) as u32,
+        n_probes,
+        phases,
+        tait_b,
+    }
+}

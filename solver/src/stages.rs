@@ -1,0 +1,188 @@
+//! The compute stages, each named as its WGSL file and entry point in `shaders/stages/`,
+//! with the bindings it declares (checked against the WGSL by `tests/shaders_validate.rs`).
+//! The CPU oracle of each physical stage lives in `physics`.
+
+use crate::gpu::stage::{Access::*, StageSpec};
+
+const COMMON: &[&str] = &["common/params.wgsl", "common/kernel.wgsl", "common/eos.wgsl", "common/grid.wgsl"];
+const WITH_NEIGHBOURS: &[&str] = &[
+    "common/params.wgsl",
+    "common/kernel.wgsl",
+    "common/eos.wgsl",
+    "common/grid.wgsl",
+    "common/neighbours.wgsl",
+    "common/step_state.wgsl",
+];
+const WITH_STATE: &[&str] = &["common/params.wgsl", "common/step_state.wgsl"];
+
+pub const GRID_CLEAR: StageSpec = StageSpec {
+    name: "grid_clear",
+    shader: "stages/grid_clear.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[("params", 0, Uniform), ("cell_starts", 1, ReadWrite), ("cell_cursor", 2, ReadWrite)],
+    entry_points: &["grid_clear"],
+    workgroup: 128,
+};
+
+pub const GRID_COUNT: StageSpec = StageSpec {
+    name: "grid_count",
+    shader: "stages/grid_count.wgsl",
+    imports: COMMON,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("positions", 1, Read),
+        ("cell_of", 2, ReadWrite),
+        ("cell_counts", 3, ReadWrite),
+    ],
+    entry_points: &["grid_count"],
+    workgroup: 128,
+};
+
+pub const PREFIX_SUM: StageSpec = StageSpec {
+    name: "prefix_sum",
+    shader: "stages/prefix_sum.wgsl",
+    imports: &[],
+    bindings: &[("scan", 0, Uniform), ("data", 1, ReadWrite), ("block_sums", 2, ReadWrite)],
+    entry_points: &["prefix_sum_block", "prefix_sum_add"],
+    workgroup: 256,
+};
+/// Elements one `prefix_sum_block` workgroup scans.
+pub const PREFIX_SUM_BLOCK: u32 = 512;
+
+pub const GRID_SCATTER: StageSpec = StageSpec {
+    name: "grid_scatter",
+    shader: "stages/grid_scatter.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("cell_of", 1, Read),
+        ("cell_starts", 2, Read),
+        ("cell_cursor", 3, ReadWrite),
+        ("sorted_index", 4, ReadWrite),
+    ],
+    entry_points: &["grid_scatter"],
+    workgroup: 128,
+};
+
+pub const CELL_SORT: StageSpec = StageSpec {
+    name: "cell_sort",
+    shader: "stages/cell_sort.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("cell_starts", 1, Read),
+        ("ids", 2, Read),
+        ("sorted_index", 3, ReadWrite),
+    ],
+    entry_points: &["cell_sort"],
+    workgroup: 128,
+};
+
+pub const REORDER: StageSpec = StageSpec {
+    name: "reorder",
+    shader: "stages/reorder.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("sorted_index", 1, Read),
+        ("positions", 2, Read),
+        ("vel_rho", 3, Read),
+        ("ids", 4, Read),
+        ("sorted_positions", 5, ReadWrite),
+        ("sorted_vel_rho", 6, ReadWrite),
+        ("sorted_ids", 7, ReadWrite),
+    ],
+    entry_points: &["reorder"],
+    workgroup: 128,
+};
+
+pub const FORCES_WCSPH: StageSpec = StageSpec {
+    name: "forces_wcsph",
+    shader: "stages/forces_wcsph.wgsl",
+    imports: WITH_NEIGHBOURS,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("positions", 1, Read),
+        ("vel_rho", 2, Read),
+        ("cell_starts", 3, Read),
+        ("forces", 4, ReadWrite),
+        ("state", 5, ReadWrite),
+    ],
+    entry_points: &["forces_wcsph"],
+    workgroup: 64,
+};
+
+pub const DT_UPDATE: StageSpec = StageSpec {
+    name: "dt_update",
+    shader: "stages/dt_update.wgsl",
+    imports: WITH_STATE,
+    bindings: &[("params", 0, Uniform), ("state", 1, ReadWrite)],
+    entry_points: &["dt_update"],
+    workgroup: 1,
+};
+
+pub const INTEGRATE_SYMPLECTIC: StageSpec = StageSpec {
+    name: "integrate_symplectic",
+    shader: "stages/integrate_symplectic.wgsl",
+    imports: WITH_STATE,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("state", 1, ReadWrite),
+        ("forces", 2, Read),
+        ("positions_n", 3, Read),
+        ("vel_rho_n", 4, Read),
+        ("ids_n", 5, Read),
+        ("positions_half", 6, ReadWrite),
+        ("vel_rho_half", 7, ReadWrite),
+        ("positions_out", 8, ReadWrite),
+        ("vel_rho_out", 9, ReadWrite),
+        ("ids_out", 10, ReadWrite),
+    ],
+    entry_points: &["predictor", "corrector"],
+    workgroup: 128,
+};
+
+pub const PROBE_INTERPOLATE: StageSpec = StageSpec {
+    name: "probe_interpolate",
+    shader: "stages/probe_interpolate.wgsl",
+    imports: WITH_NEIGHBOURS,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("positions", 1, Read),
+        ("vel_rho", 2, Read),
+        ("cell_starts", 3, Read),
+        ("probe_points", 4, Read),
+        ("probe_sums", 5, ReadWrite),
+    ],
+    entry_points: &["probe_interpolate"],
+    workgroup: 64,
+};
+
+pub const OBSERVE_REDUCE: StageSpec = StageSpec {
+    name: "observe_reduce",
+    shader: "stages/observe_reduce.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("positions", 1, Read),
+        ("vel_rho", 2, Read),
+        ("extremes", 3, ReadWrite),
+    ],
+    entry_points: &["observe_reduce"],
+    workgroup: 128,
+};
+
+/// Every stage, for validation.
+pub const ALL: &[&StageSpec] = &[
+    &GRID_CLEAR,
+    &GRID_COUNT,
+    &PREFIX_SUM,
+    &GRID_SCATTER,
+    &CELL_SORT,
+    &REORDER,
+    &FORCES_WCSPH,
+    &DT_UPDATE,
+    &INTEGRATE_SYMPLECTIC,
+    &PROBE_INTERPOLATE,
+    &OBSERVE_REDUCE,
+];
