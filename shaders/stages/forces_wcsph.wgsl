@@ -13,8 +13,6 @@
 
 // The corrector's half-step forces do not set the step: only the predictor's do (DualSPHysics).
 override REDUCE_DT: bool = true;
-// Neighbours are visited in chunks of fixed length: lavapipe runs fixed-count loops much faster.
-override NEIGHBOUR_CHUNK: u32 = 8u;
 
 @compute @workgroup_size(64)
 fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -43,12 +41,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let cell = cell_coords(pos_i.xyz);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
-        for (var base = range.x; base < range.y; base += NEIGHBOUR_CHUNK) {
-        for (var k = 0u; k < NEIGHBOUR_CHUNK; k++) {
-            let j = base + k;
-            if (j >= range.y) {
-                break;
-            }
+        for (var j = range.x; j < range.y; j++) {
             let pos_j = positions[j];
             let dx = pos_i.xyz - pos_j.xyz;
             let r2 = dot(dx, dx);
@@ -92,7 +85,6 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                 let mu_j = params.phases[phase_j].mu;
                 acc += coef * f * dx + (m_j * (mu_i + mu_j) * (r2 * f) / (rho_i * rho_j * (r2 + params.eta2))) * dv;
             }
-        }
         }
     }
     var dt_i = 3.0e38;

@@ -101,7 +101,7 @@ fn grid_for(case: &Case, h: f64) -> ([u32; 4], [f32; 4]) {
 impl Simulation {
     pub fn new(gpu: Arc<GpuContext>, case: &Case) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
-        let (grid_dims, grid_origin) = grid_for(case, derived.h);
+        let (grid_dims, _) = grid_for(case, derived.h);
         let n_cells = u64::from(grid_dims[3]);
         let count = case::count(case);
         if count >= u64::from(u32::MAX / 2) {
@@ -109,16 +109,15 @@ impl Simulation {
         }
         GpuBuffers::check_limits(&gpu, count, n_cells)?;
         let particles = case::generate(case, &derived);
-        Self::with_particles(gpu, case, derived, particles, (grid_dims, grid_origin))
+        Self::from_particles(gpu, case, particles)
     }
 
-    fn with_particles(
-        gpu: Arc<GpuContext>,
-        case: &Case,
-        derived: Derived,
-        particles: Particles,
-        (grid_dims, grid_origin): ([u32; 4], [f32; 4]),
-    ) -> Result<Simulation, SolverError> {
+    /// A simulation of `case` that starts from the given particles instead of the case's
+    /// lattice (a restored snapshot, or a test's perturbed state); phases index the case's table.
+    pub fn from_particles(gpu: Arc<GpuContext>, case: &Case, particles: Particles) -> Result<Simulation, SolverError> {
+        let derived = case::derive(case);
+        let (grid_dims, grid_origin) = grid_for(case, derived.h);
+        GpuBuffers::check_limits(&gpu, particles.len() as u64, u64::from(grid_dims[3]))?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);
         let params = sim_params(case, &derived, n, grid_dims, grid_origin, probes.points.len() as u32);
@@ -289,8 +288,9 @@ impl Simulation {
     }
 
     /// Forces and density rates (x, y, z acceleration, d rho/dt) of the current state, in id
-    /// order, without advancing: the GPU side of the force-stage test.
-    pub fn compute_forces(&self) -> Result<Vec<[f32; 4]>, SolverError> {
+    /// order, and the smallest stable step over particles (before the CFL factor), without
+    /// advancing: the GPU side of the force-stage test.
+    pub fn compute_forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         self.gpu.queue.write_buffer(
             &self.buffers.state,
             16,
@@ -303,16 +303,24 @@ impl Simulation {
         }
         self.gpu.queue.submit([encoder.finish()]);
         let n = self.particle_count() as u64;
-        let raw = read_buffers(&self.gpu, &[(&self.buffers.forces, n * 16), (&self.buffers.b.ids, n * 4)])?;
+        let raw = read_buffers(
+            &self.gpu,
+            &[
+                (&self.buffers.forces, n * 16),
+                (&self.buffers.b.ids, n * 4),
+                (&self.buffers.state, std::mem::size_of::<StepState>() as u64),
+            ],
+        )?;
         let forces: Vec<[f32; 4]> = cast_vec(&raw[0]);
         let ids: Vec<u32> = cast_vec(&raw[1]);
+        let state: StepState = bytemuck::pod_read_unaligned(&raw[2]);
         let mut out = vec![[0.0; 4]; n as usize];
         for (k, &id) in ids.iter().enumerate() {
             if let Some(slot) = out.get_mut(id as usize) {
                 *slot = forces[k];
             }
         }
-        Ok(out)
+        Ok((out, f32::from_bits(state.dt_min_bits)))
     }
 
     /// The cell list of the current state: (cell starts, particle ids in sorted order).

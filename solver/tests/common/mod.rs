@@ -40,3 +40,64 @@ pub fn validation_path(name: &str) -> std::path::PathBuf {
         .join("../../shared/validation")
         .join(name)
 }
+
+/// The CPU oracle's parameters for a simulation, read from the very uniform the GPU uses.
+pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics::Params {
+    use flume_solver::gpu::params::VISCOSITY_ARTIFICIAL;
+    use flume_solver::physics::{Params, Phase, Viscosity};
+    let p = sim.params();
+    let n_phases = sim.derived().phases.len();
+    Params {
+        dim: sim.case().dimension,
+        h: p.h,
+        c0: p.c0,
+        gravity: [p.gravity[0], p.gravity[1], p.gravity[2]],
+        delta: p.delta_h_c0 / (p.h * p.c0),
+        viscosity: if p.viscosity_mode == VISCOSITY_ARTIFICIAL {
+            Viscosity::Artificial { alpha: p.alpha }
+        } else {
+            Viscosity::Laminar
+        },
+        cfl: p.cfl,
+        phases: p.phases[..n_phases]
+            .iter()
+            .map(|ph| Phase {
+                rho0: ph.rho0,
+                mass: ph.mass,
+                mu: ph.mu,
+                mobile: ph.mobile > 0.5,
+            })
+            .collect(),
+    }
+}
+
+/// A deterministic pseudo-random stream in [-1, 1) (64-bit LCG), for perturbing states.
+pub struct Jitter(pub u64);
+
+impl Jitter {
+    pub fn next(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+    }
+}
+
+/// The case's lattice with every fluid particle displaced by up to 0.2 dp, given a velocity of
+/// up to `speed` and a density off rho0 by up to 1 %: no symmetry left to hide a wrong sign.
+pub fn perturbed(sim: &flume_solver::Simulation, speed: f32, seed: u64) -> flume_solver::case::Particles {
+    let mut p = sim.initial_particles().clone();
+    let dp = sim.case().numerics.dp_m as f32;
+    let d = sim.case().dim();
+    let mut j = Jitter(seed);
+    for i in 0..p.len() {
+        if p.phase(i) == flume_solver::case::WALL_PHASE {
+            p.vel_rho[i][3] *= 1.0 + 0.005 * (j.next() + 1.0);
+            continue;
+        }
+        for k in 0..d {
+            p.positions[i][k] += 0.2 * dp * j.next();
+            p.vel_rho[i][k] = speed * j.next();
+        }
+        p.vel_rho[i][3] *= 1.0 + 0.01 * j.next();
+    }
+    p
+}

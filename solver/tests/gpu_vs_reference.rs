@@ -1,0 +1,186 @@
+//! Tier 2: each GPU stage against its CPU oracle in `flume_solver::physics`, on lavapipe in CI.
+//! Integer stages (the cell list) must agree exactly; float stages within a stated tolerance,
+//! because the GPU sums neighbours in cell order and the oracle in index order (f32 rounding
+//! of sums whose terms cancel), and WGSL `pow` is not Rust's `powf` to the last bit.
+
+mod common;
+
+use flume_solver::physics::{integrate, interaction, probe};
+use flume_solver::{Case, Simulation};
+use std::sync::Arc;
+
+fn case(name: &str) -> Case {
+    Case::from_path(&common::case_path(name)).expect("test case parses")
+}
+
+fn max_abs(v: &[[f32; 4]], k: usize) -> f32 {
+    v.iter().map(|f| f[k].abs()).fold(0.0, f32::max)
+}
+
+/// Asserts each component agrees within `rel` of that component's largest magnitude.
+fn assert_close(what: &str, gpu: &[[f32; 4]], cpu: &[[f32; 4]], components: usize, rel: f32) {
+    assert_eq!(gpu.len(), cpu.len());
+    for k in 0..components {
+        let scale = max_abs(cpu, k).max(1e-30);
+        for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+            let err = (g[k] - c[k]).abs() / scale;
+            assert!(
+                err <= rel,
+                "{what}: particle {i} component {k}: gpu {} cpu {} (error {err:.2e} of max {scale:.3e}, allowed {rel:.0e})",
+                g[k],
+                c[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn grid_stages_match_a_cpu_counting_sort_exactly() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    // The second case is a wide, sparse 2-D tank: over 262,144 cells, so the prefix sum
+    // takes three levels.
+    let mut sparse = case("tests/cases/hydrostatic_2d.yaml");
+    sparse.domain.max_m = vec![12.0, 12.0];
+    let cases = [case("tests/cases/hydrostatic_2d.yaml"), case("tests/cases/hydrostatic_3d.yaml"), sparse];
+    for (c, seed) in cases.iter().zip(1..) {
+        let sim0 = Simulation::new(Arc::clone(&gpu), c).expect("case builds");
+        let particles = common::perturbed(&sim0, 0.0, seed);
+        let sim = Simulation::from_particles(Arc::clone(&gpu), c, particles.clone()).expect("builds");
+        let p = sim.params();
+        let (starts, sorted_ids) = sim.cell_list().expect("cell list");
+        // CPU: the same f32 cell formula, then a stable counting sort by (cell, id).
+        let dims = [p.grid_dims[0] as i64, p.grid_dims[1] as i64, p.grid_dims[2] as i64];
+        let cell_of = |x: &[f32; 4]| -> usize {
+            let mut c = [0i64; 3];
+            for k in 0..3 {
+                let v = ((x[k] - p.grid_origin[k]) * p.grid_origin[3]).floor() as i64;
+                c[k] = v.clamp(0, dims[k] - 1);
+            }
+            ((c[2] * dims[1] + c[1]) * dims[0] + c[0]) as usize
+        };
+        let n_cells = p.n_cells as usize;
+        let mut counts = vec![0u32; n_cells + 1];
+        for x in &particles.positions {
+            counts[cell_of(x)] += 1;
+        }
+        let mut expect_starts = vec![0u32; n_cells + 1];
+        for c in 0..n_cells {
+            expect_starts[c + 1] = expect_starts[c] + counts[c];
+        }
+        assert!(n_cells > 0);
+        assert_eq!(starts, expect_starts, "cell starts");
+        let mut expect_ids: Vec<u32> = (0..particles.len() as u32).collect();
+        expect_ids.sort_by_key(|&i| (cell_of(&particles.positions[i as usize]), i));
+        assert_eq!(sorted_ids, expect_ids, "particles in (cell, id) order");
+        eprintln!("{}: {} particles, {} cells: exact", c.name, particles.len(), n_cells);
+    }
+}
+
+fn check_forces(name: &str, seed: u64) {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case(name);
+    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+    let particles = common::perturbed(&sim0, 0.3, seed);
+    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
+    let cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
+    // Pairwise pressure terms reach ~1e3 m/s2 and cancel to ~g: 1e-4 of the largest value
+    // leaves room for the different summation order and nothing for a missing term.
+    assert_close(&format!("{name} acceleration"), &gpu_forces, &cpu.forces, c.dim(), 1e-4);
+    let drho: Vec<[f32; 4]> = gpu_forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
+    let drho_cpu: Vec<[f32; 4]> = cpu.forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
+    assert_close(&format!("{name} density rate"), &drho, &drho_cpu, 1, 1e-4);
+    let cpu_dt = cpu.dt_limit.iter().copied().fold(f32::INFINITY, f32::min);
+    assert!(
+        ((gpu_dt - cpu_dt) / cpu_dt).abs() < 1e-4,
+        "stable step: gpu {gpu_dt} cpu {cpu_dt}"
+    );
+    eprintln!("{name}: forces of {} particles agree; stable step {gpu_dt:.3e} s", particles.len());
+}
+
+#[test]
+fn forces_wcsph_matches_the_cpu_interaction_2d() {
+    check_forces("tests/cases/hydrostatic_2d.yaml", 7);
+}
+
+#[test]
+fn forces_wcsph_matches_the_cpu_interaction_3d() {
+    check_forces("tests/cases/hydrostatic_3d.yaml", 8);
+}
+
+#[test]
+fn forces_wcsph_laminar_matches_the_cpu_interaction() {
+    let mut c = case("tests/cases/hydrostatic_2d.yaml");
+    c.numerics.viscosity = flume_solver::config::Viscosity::Laminar;
+    c.phases[0].viscosity_pa_s = 0.5;
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+    let particles = common::perturbed(&sim0, 0.3, 9);
+    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    let (gpu_forces, _) = sim.compute_forces().expect("forces");
+    let cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
+    assert_close("laminar acceleration", &gpu_forces, &cpu.forces, 2, 1e-4);
+}
+
+#[test]
+fn one_symplectic_step_matches_the_cpu_step() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case("tests/cases/hydrostatic_2d.yaml");
+    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+    let particles = common::perturbed(&sim0, 0.3, 11);
+    let mut sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    // A target below the stable step: the GPU takes exactly one step of that length.
+    let dt = 2.0e-5f32;
+    sim.advance_to(f64::from(dt)).expect("one step");
+    assert_eq!(sim.steps(), 1);
+    let after = sim.read_particles().expect("readback");
+
+    let f_n = interaction::interact(&params, &particles.positions, &particles.vel_rho);
+    let (pos_h, vel_h) = integrate::predictor(&params.phases, dt, &particles.positions, &particles.vel_rho, &f_n.forces);
+    let f_h = interaction::interact(&params, &pos_h, &vel_h);
+    let (pos_1, vel_1) = integrate::corrector(&params.phases, dt, &particles.positions, &particles.vel_rho, &vel_h, &f_h.forces);
+    // Displacements are ~1e-5 m on positions ~0.1 m: compare the displacement itself.
+    let disp = |a: &[[f32; 4]]| -> Vec<[f32; 4]> {
+        a.iter().zip(&particles.positions).map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], 0.0, 0.0]).collect()
+    };
+    assert_close("displacement", &disp(&after.positions), &disp(&pos_1), 2, 1e-3);
+    assert_close("velocity and density", &after.vel_rho, &vel_1, 4, 1e-4);
+}
+
+#[test]
+fn probe_interpolate_and_observe_reduce_match_the_cpu() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case("tests/cases/hydrostatic_2d.yaml");
+    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+    let particles = common::perturbed(&sim0, 0.3, 13);
+    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    let obs = sim.observe().expect("observe");
+    for (reading, cfg) in obs.probes.iter().zip(&c.observations.pressure_probes) {
+        let x = &cfg.position_m;
+        let sums = probe::probe(&params, [x[0] as f32, x[1] as f32, 0.0], &particles.positions, &particles.vel_rho);
+        let cpu = f64::from(sums.pressure().expect("probe in water"));
+        let gpu = reading.pressure_pa.expect("probe in water");
+        assert!((gpu - cpu).abs() <= 1e-4 * cpu.abs().max(1.0), "{}: gpu {gpu} cpu {cpu}", cfg.name);
+    }
+    let fluid: Vec<usize> = (0..particles.len()).filter(|&i| particles.phase(i) != 0).collect();
+    let front = fluid.iter().map(|&i| particles.positions[i][0]).fold(f32::MIN, f32::max);
+    let speed = fluid
+        .iter()
+        .map(|&i| {
+            let v = particles.vel_rho[i];
+            (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+        })
+        .fold(0.0f32, f32::max);
+    assert_eq!(obs.front_m, f64::from(front));
+    assert!((obs.max_speed_m_per_s - f64::from(speed)).abs() <= 1e-6 * f64::from(speed));
+    assert_eq!(obs.fluid_particles as usize, fluid.len());
+}
