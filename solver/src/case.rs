@@ -56,8 +56,18 @@ pub struct Derived {
 
 fn lattice_bounds(case: &Case) -> (Vec<i64>, Vec<i64>) {
     let dp = case.numerics.dp_m;
-    let lo = case.domain.min_m.iter().map(|v| (v / dp).round() as i64).collect();
-    let hi = case.domain.max_m.iter().map(|v| (v / dp).round() as i64).collect();
+    let lo = case
+        .domain
+        .min_m
+        .iter()
+        .map(|v| (v / dp).round() as i64)
+        .collect();
+    let hi = case
+        .domain
+        .max_m
+        .iter()
+        .map(|v| (v / dp).round() as i64)
+        .collect();
     (lo, hi)
 }
 
@@ -120,7 +130,10 @@ fn wall_box(case: &Case, lo: &[i64], hi: &[i64]) -> (Vec<i64>, Vec<i64>) {
 
 fn block_bounds(case: &Case, min: &[f64], max: &[f64]) -> (Vec<i64>, Vec<i64>) {
     let dp = case.numerics.dp_m;
-    let lo = min.iter().map(|v| (v / dp + 1e-6).floor() as i64 + 1).collect();
+    let lo = min
+        .iter()
+        .map(|v| (v / dp + 1e-6).floor() as i64 + 1)
+        .collect();
     let hi = max.iter().map(|v| (v / dp + 1e-6).floor() as i64).collect();
     (lo, hi)
 }
@@ -144,11 +157,25 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
         out.vel_rho.push([0.0, 0.0, 0.0, rho as f32]);
     };
     let (wlo, whi) = wall_box(case, &lo, &hi);
-    let wall_rho = derived.phases[WALL_PHASE as usize].rho0;
+    let wall = derived.phases[WALL_PHASE as usize];
+    let wall_b = tait_b(derived.c0, wall.rho0);
+    let reach = f64::from(case.walls.layers) * dp + 1e-9;
     for_each_point(&wlo, &whi, |p| {
         if is_wall(case, p, &lo, &hi) {
             taken.insert(p.to_vec());
-            push(p, WALL_PHASE, wall_rho, &mut out);
+            // Walls under a fluid block start at its hydrostatic density, so that the fluid
+            // does not first sink into walls at rest density; walls elsewhere start at rho0.
+            let x: Vec<f64> = p.iter().map(|v| *v as f64 * dp).collect();
+            let depth = case
+                .fluid_blocks
+                .iter()
+                .filter(|b| {
+                    (0..d - 1).all(|k| x[k] >= b.min_m[k] - reach && x[k] <= b.max_m[k] + reach)
+                })
+                .map(|b| b.max_m[d - 1] - x[d - 1])
+                .fold(0.0f64, f64::max);
+            let rho = wall.rho0 * (1.0 + wall.rho0 * gravity * depth / wall_b).powf(1.0 / 7.0);
+            push(p, WALL_PHASE, rho, &mut out);
         }
     });
     for block in &case.fluid_blocks {
@@ -176,12 +203,23 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
 pub fn count(case: &Case) -> u64 {
     let (lo, hi) = lattice_bounds(case);
     let (wlo, whi) = wall_box(case, &lo, &hi);
-    let boxes = |a: &[i64], b: &[i64]| -> u64 { a.iter().zip(b).map(|(l, h)| (h - l + 1).max(0) as u64).product() };
+    let boxes = |a: &[i64], b: &[i64]| -> u64 {
+        a.iter()
+            .zip(b)
+            .map(|(l, h)| (h - l + 1).max(0) as u64)
+            .product()
+    };
     let d = lo.len();
     // Walls: the wall box minus its interior (lattice points strictly inside the tank's faces).
     let inner_lo: Vec<i64> = lo.iter().map(|v| v + 1).collect();
     let inner_hi: Vec<i64> = (0..d)
-        .map(|k| if k == d - 1 && !case.walls.closed_top { hi[k] } else { hi[k] - 1 })
+        .map(|k| {
+            if k == d - 1 && !case.walls.closed_top {
+                hi[k]
+            } else {
+                hi[k] - 1
+            }
+        })
         .collect();
     let mut n = boxes(&wlo, &whi) - boxes(&inner_lo, &inner_hi);
     // Fluid blocks: an upper bound when blocks overlap, exact otherwise; it only guards limits.
@@ -194,7 +232,8 @@ pub fn count(case: &Case) -> u64 {
     n
 }
 
-fn tait_b(c0: f64, rho0: f64) -> f64 {
+/// The Tait constant B = c0^2 rho0 / 7 (Eq. 4, gamma = 7), in f64 for case setup.
+pub fn tait_b(c0: f64, rho0: f64) -> f64 {
     c0 * c0 * rho0 / 7.0
 }
 

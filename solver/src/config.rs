@@ -139,9 +139,13 @@ pub struct SoundSpeed {
 pub enum DensityDiffusion {
     None,
     /// Molteni & Colagrossi 2009.
-    MolteniColagrossi2009 { delta: f64 },
+    MolteniColagrossi2009 {
+        delta: f64,
+    },
     /// Molteni-Colagrossi with the hydrostatic correction of Fourtakas et al. 2019.
-    Fourtakas2019 { delta: f64 },
+    Fourtakas2019 {
+        delta: f64,
+    },
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
@@ -233,12 +237,20 @@ impl Case {
 
     /// Smoothing length h, m.
     pub fn smoothing_length_m(&self) -> f64 {
-        self.numerics.coefh * f64::from(self.dimension).sqrt() * self.numerics.dp_m
+        crate::physics::kernel::smoothing_length(
+            self.numerics.coefh,
+            self.dimension,
+            self.numerics.dp_m,
+        )
     }
 
     /// Magnitude of gravity, m/s2.
     pub fn gravity_magnitude(&self) -> f64 {
-        self.gravity_m_per_s2.iter().map(|g| g * g).sum::<f64>().sqrt()
+        self.gravity_m_per_s2
+            .iter()
+            .map(|g| g * g)
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// Index of a phase by name; phase 0 on the GPU is the wall, so fluid phase k is k + 1.
@@ -249,7 +261,10 @@ impl Case {
     fn validate(&self) -> Result<(), (String, String)> {
         let err = |field: &str, reason: String| Err((field.to_string(), reason));
         if self.dimension != 2 && self.dimension != 3 {
-            return err("dimension", format!("must be 2 or 3, got {}", self.dimension));
+            return err(
+                "dimension",
+                format!("must be 2 or 3, got {}", self.dimension),
+            );
         }
         let d = self.dim();
         for (field, v) in [
@@ -267,14 +282,19 @@ impl Case {
                 );
             }
         }
-        if self.gravity_m_per_s2[..d - 1].iter().any(|g| *g != 0.0) || self.gravity_m_per_s2[d - 1] >= 0.0 {
+        if self.gravity_m_per_s2[..d - 1].iter().any(|g| *g != 0.0)
+            || self.gravity_m_per_s2[d - 1] >= 0.0
+        {
             return err(
                 "gravity_m_per_s2",
                 "must point down the last (vertical) axis, e.g. [0, -9.81]".to_string(),
             );
         }
         if self.walls.layers == 0 || self.walls.layers > 8 {
-            return err("walls.layers", format!("must be 1..=8, got {}", self.walls.layers));
+            return err(
+                "walls.layers",
+                format!("must be 1..=8, got {}", self.walls.layers),
+            );
         }
         if self.phases.is_empty() {
             return err("phases", "at least one phase is needed".to_string());
@@ -284,17 +304,29 @@ impl Case {
         }
         for (i, p) in self.phases.iter().enumerate() {
             if !(p.rho0_kg_per_m3.is_finite() && p.rho0_kg_per_m3 > 0.0) {
-                return err(&format!("phases[{i}].rho0_kg_per_m3"), "must be a positive number".into());
+                return err(
+                    &format!("phases[{i}].rho0_kg_per_m3"),
+                    "must be a positive number".into(),
+                );
             }
             if !(p.viscosity_pa_s.is_finite() && p.viscosity_pa_s >= 0.0) {
-                return err(&format!("phases[{i}].viscosity_pa_s"), "must be >= 0".into());
+                return err(
+                    &format!("phases[{i}].viscosity_pa_s"),
+                    "must be >= 0".into(),
+                );
             }
             if self.phases[..i].iter().any(|q| q.name == p.name) {
-                return err(&format!("phases[{i}].name"), format!("`{}` is defined twice", p.name));
+                return err(
+                    &format!("phases[{i}].name"),
+                    format!("`{}` is defined twice", p.name),
+                );
             }
         }
         if self.fluid_blocks.is_empty() {
-            return err("fluid_blocks", "at least one block of fluid is needed".to_string());
+            return err(
+                "fluid_blocks",
+                "at least one block of fluid is needed".to_string(),
+            );
         }
         for (i, b) in self.fluid_blocks.iter().enumerate() {
             if self.phase_index(&b.phase).is_none() {
@@ -307,48 +339,83 @@ impl Case {
             check_vector(&format!("fluid_blocks[{i}].max_m"), &b.max_m, d)?;
             for k in 0..d {
                 if b.max_m[k] <= b.min_m[k] {
-                    return err(&format!("fluid_blocks[{i}].max_m"), format!("component {k} must exceed min_m's"));
+                    return err(
+                        &format!("fluid_blocks[{i}].max_m"),
+                        format!("component {k} must exceed min_m's"),
+                    );
                 }
-                if b.min_m[k] < self.domain.min_m[k] - 1e-9 || b.max_m[k] > self.domain.max_m[k] + 1e-9 {
-                    return err(&format!("fluid_blocks[{i}]"), "must lie inside the domain".to_string());
+                if b.min_m[k] < self.domain.min_m[k] - 1e-9
+                    || b.max_m[k] > self.domain.max_m[k] + 1e-9
+                {
+                    return err(
+                        &format!("fluid_blocks[{i}]"),
+                        "must lie inside the domain".to_string(),
+                    );
                 }
             }
         }
         let n = &self.numerics;
-        let extent = (0..d).map(|k| self.domain.max_m[k] - self.domain.min_m[k]).fold(f64::MAX, f64::min);
+        let extent = (0..d)
+            .map(|k| self.domain.max_m[k] - self.domain.min_m[k])
+            .fold(f64::MAX, f64::min);
         if !(n.dp_m.is_finite() && n.dp_m > 0.0 && n.dp_m < extent / 4.0) {
-            return err("numerics.dp_m", format!("must be positive and below a quarter of the smallest tank size ({extent} m), got {}", n.dp_m));
+            return err(
+                "numerics.dp_m",
+                format!(
+                    "must be positive and below a quarter of the smallest tank size ({extent} m), got {}",
+                    n.dp_m
+                ),
+            );
         }
         if !(n.coefh.is_finite() && (0.5..=3.0).contains(&n.coefh)) {
-            return err("numerics.coefh", format!("must be in 0.5..=3, got {}", n.coefh));
+            return err(
+                "numerics.coefh",
+                format!("must be in 0.5..=3, got {}", n.coefh),
+            );
         }
         if !(n.cfl.is_finite() && n.cfl > 0.0 && n.cfl <= 1.0) {
             return err("numerics.cfl", format!("must be in (0, 1], got {}", n.cfl));
         }
         match (n.sound_speed.c0_m_per_s, n.sound_speed.coefsound) {
             (Some(c), None) if !(c.is_finite() && c > 0.0) => {
-                return err("numerics.sound_speed.c0_m_per_s", format!("must be positive, got {c}"));
+                return err(
+                    "numerics.sound_speed.c0_m_per_s",
+                    format!("must be positive, got {c}"),
+                );
             }
             (None, Some(c)) if !(c.is_finite() && c > 0.0) => {
-                return err("numerics.sound_speed.coefsound", format!("must be positive, got {c}"));
+                return err(
+                    "numerics.sound_speed.coefsound",
+                    format!("must be positive, got {c}"),
+                );
             }
             (Some(_), Some(_)) | (None, None) => {
-                return err("numerics.sound_speed", "give exactly one of c0_m_per_s and coefsound".into());
+                return err(
+                    "numerics.sound_speed",
+                    "give exactly one of c0_m_per_s and coefsound".into(),
+                );
             }
             _ => {}
         }
         match n.density_diffusion {
-            DensityDiffusion::MolteniColagrossi2009 { delta } | DensityDiffusion::Fourtakas2019 { delta }
+            DensityDiffusion::MolteniColagrossi2009 { delta }
+            | DensityDiffusion::Fourtakas2019 { delta }
                 if !(delta.is_finite() && (0.0..=1.0).contains(&delta)) =>
             {
-                return err("numerics.density_diffusion.delta", format!("must be in 0..=1, got {delta}"));
+                return err(
+                    "numerics.density_diffusion.delta",
+                    format!("must be in 0..=1, got {delta}"),
+                );
             }
             _ => {}
         }
         if let Viscosity::Artificial { alpha } = n.viscosity
             && !(alpha.is_finite() && (0.0..=10.0).contains(&alpha))
         {
-            return err("numerics.viscosity.alpha", format!("must be in 0..=10, got {alpha}"));
+            return err(
+                "numerics.viscosity.alpha",
+                format!("must be in 0..=10, got {alpha}"),
+            );
         }
         let t = &self.time;
         if !(t.end_s.is_finite() && t.end_s > 0.0) {
@@ -358,15 +425,26 @@ impl Case {
             return err("time.output_interval_s", "must be positive".into());
         }
         for (i, g) in self.observations.gauges.iter().enumerate() {
-            check_vector(&format!("observations.gauges[{i}].position_m"), &g.position_m, d - 1)?;
+            check_vector(
+                &format!("observations.gauges[{i}].position_m"),
+                &g.position_m,
+                d - 1,
+            )?;
             for k in 0..d - 1 {
                 if !(self.domain.min_m[k]..=self.domain.max_m[k]).contains(&g.position_m[k]) {
-                    return err(&format!("observations.gauges[{i}].position_m"), "must lie inside the domain".into());
+                    return err(
+                        &format!("observations.gauges[{i}].position_m"),
+                        "must lie inside the domain".into(),
+                    );
                 }
             }
         }
         for (i, p) in self.observations.pressure_probes.iter().enumerate() {
-            check_vector(&format!("observations.pressure_probes[{i}].position_m"), &p.position_m, d)?;
+            check_vector(
+                &format!("observations.pressure_probes[{i}].position_m"),
+                &p.position_m,
+                d,
+            )?;
         }
         Ok(())
     }
@@ -374,10 +452,16 @@ impl Case {
 
 fn check_vector(field: &str, v: &[f64], len: usize) -> Result<(), (String, String)> {
     if v.len() != len {
-        return Err((field.to_string(), format!("needs {len} components, got {}", v.len())));
+        return Err((
+            field.to_string(),
+            format!("needs {len} components, got {}", v.len()),
+        ));
     }
     if v.iter().any(|x| !x.is_finite()) {
-        return Err((field.to_string(), "components must be finite numbers".to_string()));
+        return Err((
+            field.to_string(),
+            "components must be finite numbers".to_string(),
+        ));
     }
     Ok(())
 }

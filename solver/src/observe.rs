@@ -59,7 +59,8 @@ impl ProbeLayout {
             let heights: Vec<f64> = (0..n).map(|k| bottom + k as f64 * step).collect();
             for &z in &heights {
                 let mut p = [0.0f32; 4];
-                p[..d - 1].copy_from_slice(&g.position_m.iter().map(|v| *v as f32).collect::<Vec<_>>());
+                p[..d - 1]
+                    .copy_from_slice(&g.position_m.iter().map(|v| *v as f32).collect::<Vec<_>>());
                 p[d - 1] = z as f32;
                 points.push(p);
             }
@@ -68,8 +69,8 @@ impl ProbeLayout {
         let mut probes = Vec::new();
         for p in &case.observations.pressure_probes {
             let mut q = [0.0f32; 4];
-            for k in 0..d {
-                q[k] = p.position_m[k] as f32;
+            for (qk, v) in q.iter_mut().zip(&p.position_m) {
+                *qk = *v as f32;
             }
             points.push(q);
             probes.push(p.name.clone());
@@ -81,11 +82,21 @@ impl ProbeLayout {
         }
     }
 
-    pub fn observations(&self, time_s: f64, steps: u64, dt_s: f64, sums: &[[f32; 2]], ext: &Extremes) -> Observations {
+    pub fn observations(
+        &self,
+        time_s: f64,
+        steps: u64,
+        dt_s: f64,
+        sums: &[[f32; 2]],
+        ext: &Extremes,
+    ) -> Observations {
         let mut offset = 0;
         let mut gauges = Vec::new();
         for (name, heights) in &self.gauges {
-            let fullness: Vec<f32> = sums[offset..offset + heights.len()].iter().map(|s| s[0]).collect();
+            let fullness: Vec<f32> = sums[offset..offset + heights.len()]
+                .iter()
+                .map(|s| s[0])
+                .collect();
             offset += heights.len();
             gauges.push(GaugeReading {
                 name: name.clone(),

@@ -9,6 +9,10 @@ use crate::gpu::stage::{Stage, groups};
 use crate::gpu::{GpuContext, GpuError};
 use crate::stages::{self, PREFIX_SUM_BLOCK};
 
+/// Cells per kernel support 2h along each axis (see `shaders/common/neighbours.wgsl`): with 2,
+/// the neighbour loops visit about a third fewer candidates than with cells of 2h.
+pub const CELL_DIVISIONS: u32 = 1;
+
 pub struct SphPipeline {
     grid_clear: Stage,
     grid_count: Stage,
@@ -27,8 +31,12 @@ pub struct SphPipeline {
 impl SphPipeline {
     pub fn new(gpu: &GpuContext, dim: u32) -> SphPipeline {
         let d = &gpu.device;
-        let rows = if dim == 2 { 3.0 } else { 9.0 };
-        let stencil = [("STENCIL_ROWS", rows)];
+        let width = f64::from(2 * CELL_DIVISIONS + 1);
+        let rows = if dim == 2 { width } else { width * width };
+        let stencil = [
+            ("STENCIL_ROWS", rows),
+            ("CELL_DIVISIONS", f64::from(CELL_DIVISIONS)),
+        ];
         SphPipeline {
             grid_clear: Stage::new(d, &stages::GRID_CLEAR, &[]),
             grid_count: Stage::new(d, &stages::GRID_COUNT, &[]),
@@ -36,8 +44,16 @@ impl SphPipeline {
             grid_scatter: Stage::new(d, &stages::GRID_SCATTER, &[]),
             cell_sort: Stage::new(d, &stages::CELL_SORT, &[]),
             reorder: Stage::new(d, &stages::REORDER, &[]),
-            forces_predict: Stage::new(d, &stages::FORCES_WCSPH, &[stencil[0], ("REDUCE_DT", 1.0)]),
-            forces_correct: Stage::new(d, &stages::FORCES_WCSPH, &[stencil[0], ("REDUCE_DT", 0.0)]),
+            forces_predict: Stage::new(
+                d,
+                &stages::FORCES_WCSPH,
+                &[stencil[0], stencil[1], ("REDUCE_DT", 1.0)],
+            ),
+            forces_correct: Stage::new(
+                d,
+                &stages::FORCES_WCSPH,
+                &[stencil[0], stencil[1], ("REDUCE_DT", 0.0)],
+            ),
             dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
             integrate: Stage::new(d, &stages::INTEGRATE_SYMPLECTIC, &[]),
             probe_interpolate: Stage::new(d, &stages::PROBE_INTERPOLATE, &stencil),
@@ -110,8 +126,19 @@ impl GpuBuffers {
         let mut len = n_cells + 1;
         loop {
             let blocks = len.div_ceil(PREFIX_SUM_BLOCK);
-            let info = crate::gpu::buffers::uniform_init(gpu, "scan info", &ScanInfo { n: len, pad: [0; 3] });
-            scan_levels.push((info, storage(gpu, "scan block sums", u64::from(blocks) * 4), len));
+            let info = crate::gpu::buffers::uniform_init(
+                gpu,
+                "scan info",
+                &ScanInfo {
+                    n: len,
+                    pad: [0; 3],
+                },
+            );
+            scan_levels.push((
+                info,
+                storage(gpu, "scan block sums", u64::from(blocks) * 4),
+                len,
+            ));
             if blocks == 1 {
                 break;
             }
@@ -156,7 +183,14 @@ pub struct Bindings {
 }
 
 impl SphPipeline {
-    pub fn bind(&self, gpu: &GpuContext, g: &GpuBuffers, n_particles: u32, n_cells: u32, n_probes: u32) -> Bindings {
+    pub fn bind(
+        &self,
+        gpu: &GpuContext,
+        g: &GpuBuffers,
+        n_particles: u32,
+        n_cells: u32,
+        n_probes: u32,
+    ) -> Bindings {
         let d = &gpu.device;
         let mut scan = Vec::new();
         let mut data = &g.cell_starts;
@@ -165,14 +199,26 @@ impl SphPipeline {
             data = sums;
         }
         Bindings {
-            grid_clear: self.grid_clear.bind(d, &[&g.params, &g.cell_starts, &g.cell_cursor]),
-            grid_count: self.grid_count.bind(d, &[&g.params, &g.a.positions, &g.cell_of, &g.cell_starts]),
+            grid_clear: self
+                .grid_clear
+                .bind(d, &[&g.params, &g.cell_starts, &g.cell_cursor]),
+            grid_count: self
+                .grid_count
+                .bind(d, &[&g.params, &g.a.positions, &g.cell_of, &g.cell_starts]),
             scan,
             grid_scatter: self.grid_scatter.bind(
                 d,
-                &[&g.params, &g.cell_of, &g.cell_starts, &g.cell_cursor, &g.sorted_index],
+                &[
+                    &g.params,
+                    &g.cell_of,
+                    &g.cell_starts,
+                    &g.cell_cursor,
+                    &g.sorted_index,
+                ],
             ),
-            cell_sort: self.cell_sort.bind(d, &[&g.params, &g.cell_starts, &g.a.ids, &g.sorted_index]),
+            cell_sort: self
+                .cell_sort
+                .bind(d, &[&g.params, &g.cell_starts, &g.a.ids, &g.sorted_index]),
             reorder: self.reorder.bind(
                 d,
                 &[
@@ -188,11 +234,25 @@ impl SphPipeline {
             ),
             forces_predict: self.forces_predict.bind(
                 d,
-                &[&g.params, &g.b.positions, &g.b.vel_rho, &g.cell_starts, &g.forces, &g.state],
+                &[
+                    &g.params,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.cell_starts,
+                    &g.forces,
+                    &g.state,
+                ],
             ),
             forces_correct: self.forces_correct.bind(
                 d,
-                &[&g.params, &g.c_positions, &g.c_vel_rho, &g.cell_starts, &g.forces, &g.state],
+                &[
+                    &g.params,
+                    &g.c_positions,
+                    &g.c_vel_rho,
+                    &g.cell_starts,
+                    &g.forces,
+                    &g.state,
+                ],
             ),
             dt_update: self.dt_update.bind(d, &[&g.params, &g.state]),
             integrate: self.integrate.bind(
@@ -213,9 +273,18 @@ impl SphPipeline {
             ),
             probe_interpolate: self.probe_interpolate.bind(
                 d,
-                &[&g.params, &g.b.positions, &g.b.vel_rho, &g.cell_starts, &g.probe_points, &g.probe_sums],
+                &[
+                    &g.params,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.cell_starts,
+                    &g.probe_points,
+                    &g.probe_sums,
+                ],
             ),
-            observe_reduce: self.observe_reduce.bind(d, &[&g.params, &g.a.positions, &g.a.vel_rho, &g.extremes]),
+            observe_reduce: self
+                .observe_reduce
+                .bind(d, &[&g.params, &g.a.positions, &g.a.vel_rho, &g.extremes]),
             n_particles,
             n_cells,
             n_probes,
@@ -226,17 +295,23 @@ impl SphPipeline {
     pub fn record_sort(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         let cells = b.n_cells + 1;
-        self.grid_clear.record(pass, 0, &b.grid_clear, groups(cells, 128));
-        self.grid_count.record(pass, 0, &b.grid_count, groups(n, 128));
+        self.grid_clear
+            .record(pass, 0, &b.grid_clear, groups(cells, 128));
+        self.grid_count
+            .record(pass, 0, &b.grid_count, groups(n, 128));
         // Exclusive scan of the counts into cell starts, level by level, then added back down.
         for (bind, len) in &b.scan {
-            self.prefix_sum.record(pass, 0, bind, groups(*len, PREFIX_SUM_BLOCK));
+            self.prefix_sum
+                .record(pass, 0, bind, groups(*len, PREFIX_SUM_BLOCK));
         }
         for (bind, len) in b.scan.iter().rev().skip(1) {
-            self.prefix_sum.record(pass, 1, bind, groups(*len, PREFIX_SUM_BLOCK));
+            self.prefix_sum
+                .record(pass, 1, bind, groups(*len, PREFIX_SUM_BLOCK));
         }
-        self.grid_scatter.record(pass, 0, &b.grid_scatter, groups(n, 128));
-        self.cell_sort.record(pass, 0, &b.cell_sort, groups(b.n_cells, 128));
+        self.grid_scatter
+            .record(pass, 0, &b.grid_scatter, groups(n, 128));
+        self.cell_sort
+            .record(pass, 0, &b.cell_sort, groups(b.n_cells, 128));
         self.reorder.record(pass, 0, &b.reorder, groups(n, 128));
     }
 
@@ -245,23 +320,28 @@ impl SphPipeline {
     pub fn record_step(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         self.record_sort(pass, b);
-        self.forces_predict.record(pass, 0, &b.forces_predict, groups(n, 64));
+        self.forces_predict
+            .record(pass, 0, &b.forces_predict, groups(n, 64));
         self.dt_update.record(pass, 0, &b.dt_update, 1);
         self.integrate.record(pass, 0, &b.integrate, groups(n, 128));
-        self.forces_correct.record(pass, 0, &b.forces_correct, groups(n, 64));
+        self.forces_correct
+            .record(pass, 0, &b.forces_correct, groups(n, 64));
         self.integrate.record(pass, 1, &b.integrate, groups(n, 128));
     }
 
     /// Forces at the current state only (no integration): for tests against the CPU oracle.
     pub fn record_forces(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
-        self.forces_predict.record(pass, 0, &b.forces_predict, groups(b.n_particles, 64));
+        self.forces_predict
+            .record(pass, 0, &b.forces_predict, groups(b.n_particles, 64));
     }
 
     /// Observation passes: probe sums on the sorted state and the whole-state maxima.
     pub fn record_observe(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
-        self.probe_interpolate.record(pass, 0, &b.probe_interpolate, groups(b.n_probes, 64));
-        self.observe_reduce.record(pass, 0, &b.observe_reduce, groups(b.n_particles, 128));
+        self.probe_interpolate
+            .record(pass, 0, &b.probe_interpolate, groups(b.n_probes, 64));
+        self.observe_reduce
+            .record(pass, 0, &b.observe_reduce, groups(b.n_particles, 128));
     }
 }

@@ -19,7 +19,11 @@ pub enum SolverError {
     #[error("the case has {0} particles; the solver's indices are 32-bit")]
     TooManyParticles(u64),
     #[error("simulation blew up at t = {time_s:.6} s (step {step}): {health}")]
-    BlowUp { time_s: f64, step: u64, health: Health },
+    BlowUp {
+        time_s: f64,
+        step: u64,
+        health: Health,
+    },
     #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
     TimeGoesBack { target_s: f64, now_s: f64 },
 }
@@ -76,10 +80,10 @@ pub struct Simulation {
     initial_particles: Particles,
 }
 
-/// Grid of cells of size 2h covering the tank, its walls and a margin above it.
+/// Grid of cells of size 2h / CELL_DIVISIONS covering the tank, its walls and a margin above it.
 fn grid_for(case: &Case, h: f64) -> ([u32; 4], [f32; 4]) {
     let d = case.dim();
-    let cell = 2.0 * h;
+    let cell = 2.0 * h / f64::from(crate::pipeline::CELL_DIVISIONS);
     let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
     let mut dims = [1u32; 4];
     let mut origin = [0.0f32; 4];
@@ -114,13 +118,24 @@ impl Simulation {
 
     /// A simulation of `case` that starts from the given particles instead of the case's
     /// lattice (a restored snapshot, or a test's perturbed state); phases index the case's table.
-    pub fn from_particles(gpu: Arc<GpuContext>, case: &Case, particles: Particles) -> Result<Simulation, SolverError> {
+    pub fn from_particles(
+        gpu: Arc<GpuContext>,
+        case: &Case,
+        particles: Particles,
+    ) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
         let (grid_dims, grid_origin) = grid_for(case, derived.h);
         GpuBuffers::check_limits(&gpu, particles.len() as u64, u64::from(grid_dims[3]))?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);
-        let params = sim_params(case, &derived, n, grid_dims, grid_origin, probes.points.len() as u32);
+        let params = sim_params(
+            case,
+            &derived,
+            n,
+            grid_dims,
+            grid_origin,
+            probes.points.len() as u32,
+        );
         let a = StateBuffers {
             positions: storage_init(&gpu, "a.positions", &particles.positions),
             vel_rho: storage_init(&gpu, "a.vel_rho", &particles.vel_rho),
@@ -133,8 +148,11 @@ impl Simulation {
             params.n_cells,
             params.n_probes,
         );
-        gpu.queue
-            .write_buffer(&buffers.probe_points, 0, bytemuck::cast_slice(&probes.points));
+        gpu.queue.write_buffer(
+            &buffers.probe_points,
+            0,
+            bytemuck::cast_slice(&probes.points),
+        );
         let pipeline = SphPipeline::new(&gpu, case.dimension);
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
         Ok(Simulation {
@@ -197,21 +215,18 @@ impl Simulation {
         if rel_target <= 0.0 {
             return Ok(());
         }
-        let init = StepState {
-            dt: 0.0,
-            t_rel: 0.0,
-            t_target: rel_target,
-            steps: 0,
-            dt_min_bits: f32::MAX.to_bits(),
-            status: 0,
-            last_dt: self.last_dt_s as f32,
-            pad: 0,
-        };
+        let init = StepState::chunk(rel_target, self.last_dt_s as f32);
         self.gpu
             .queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
         let mut done_steps = 0u32;
-        let mut batch = 8u32;
+        let mut batch = if self.last_dt_s > 0.0 {
+            ((target_s - chunk_start) / self.last_dt_s)
+                .ceil()
+                .clamp(1.0, f64::from(MAX_STEPS_PER_SUBMIT)) as u32
+        } else {
+            8
+        };
         loop {
             self.submit_steps(batch);
             let state = self.read_state()?;
@@ -234,7 +249,7 @@ impl Simulation {
             self.time_s = chunk_start + f64::from(state.t_rel);
             let remaining = f64::from(state.t_target - state.t_rel);
             let estimate = if state.last_dt > 0.0 {
-                (remaining / f64::from(state.last_dt)).ceil() as u32 + 1
+                (remaining / f64::from(state.last_dt)).ceil() as u32
             } else {
                 batch * 2
             };
@@ -246,7 +261,9 @@ impl Simulation {
         let mut encoder = self
             .gpu
             .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("steps") });
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("steps"),
+            });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("sph steps"),
@@ -260,7 +277,10 @@ impl Simulation {
     }
 
     fn read_state(&self) -> Result<StepState, GpuError> {
-        let bytes = read_buffers(&self.gpu, &[(&self.buffers.state, std::mem::size_of::<StepState>() as u64)])?;
+        let bytes = read_buffers(
+            &self.gpu,
+            &[(&self.buffers.state, std::mem::size_of::<StepState>() as u64)],
+        )?;
         Ok(bytemuck::pod_read_unaligned(&bytes[0]))
     }
 
@@ -268,7 +288,14 @@ impl Simulation {
     pub fn read_particles(&self) -> Result<Particles, SolverError> {
         let n = self.particle_count() as u64;
         let a = &self.buffers.a;
-        let raw = read_buffers(&self.gpu, &[(&a.positions, n * 16), (&a.vel_rho, n * 16), (&a.ids, n * 4)])?;
+        let raw = read_buffers(
+            &self.gpu,
+            &[
+                (&a.positions, n * 16),
+                (&a.vel_rho, n * 16),
+                (&a.ids, n * 4),
+            ],
+        )?;
         let positions: Vec<[f32; 4]> = cast_vec(&raw[0]);
         let vel_rho: Vec<[f32; 4]> = cast_vec(&raw[1]);
         let ids: Vec<u32> = cast_vec(&raw[2]);
@@ -291,11 +318,11 @@ impl Simulation {
     /// order, and the smallest stable step over particles (before the CFL factor), without
     /// advancing: the GPU side of the force-stage test.
     pub fn compute_forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
-        self.gpu.queue.write_buffer(
-            &self.buffers.state,
-            16,
-            bytemuck::bytes_of(&f32::MAX.to_bits()),
-        );
+        // A chunk that has not ended, so the force pass runs.
+        let open = StepState::chunk(f32::MAX, 0.0);
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&open));
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -333,7 +360,13 @@ impl Simulation {
         self.gpu.queue.submit([encoder.finish()]);
         let n = self.particle_count() as u64;
         let cells = u64::from(self.params.n_cells) + 1;
-        let raw = read_buffers(&self.gpu, &[(&self.buffers.cell_starts, cells * 4), (&self.buffers.b.ids, n * 4)])?;
+        let raw = read_buffers(
+            &self.gpu,
+            &[
+                (&self.buffers.cell_starts, cells * 4),
+                (&self.buffers.b.ids, n * 4),
+            ],
+        )?;
         Ok((cast_vec(&raw[0]), cast_vec(&raw[1])))
     }
 
@@ -361,28 +394,34 @@ impl Simulation {
         let raw = read_buffers(
             &self.gpu,
             &[
-                (&self.buffers.probe_sums, self.probes.points.len() as u64 * 8),
+                (
+                    &self.buffers.probe_sums,
+                    self.probes.points.len() as u64 * 8,
+                ),
                 (&self.buffers.extremes, 16),
             ],
         )?;
         let sums: Vec<[f32; 2]> = cast_vec(&raw[0]);
         let ext: Extremes = bytemuck::pod_read_unaligned(&raw[1]);
-        Ok(self.probes.observations(
-            self.time_s,
-            self.steps,
-            self.last_dt_s,
-            &sums,
-            &ext,
-        ))
+        Ok(self
+            .probes
+            .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext))
     }
 }
 
-fn sim_params(case: &Case, derived: &Derived, n: u32, grid_dims: [u32; 4], grid_origin: [f32; 4], n_probes: u32) -> SimParams {
+fn sim_params(
+    case: &Case,
+    derived: &Derived,
+    n: u32,
+    grid_dims: [u32; 4],
+    grid_origin: [f32; 4],
+    n_probes: u32,
+) -> SimParams {
     let d = case.dim();
     let h = derived.h;
     let mut gravity = [0.0f32; 4];
-    for k in 0..d {
-        gravity[k] = case.gravity_m_per_s2[k] as f32;
+    for (gk, v) in gravity.iter_mut().zip(&case.gravity_m_per_s2) {
+        *gk = *v as f32;
     }
     gravity[3] = (-case.gravity_m_per_s2[d - 1]) as f32;
     let mut phases = [PhaseParams {
@@ -400,8 +439,11 @@ fn sim_params(case: &Case, derived: &Derived, n: u32, grid_dims: [u32; 4], grid_
             mu: p.viscosity_pa_s as f32,
             mobile: if p.mobile { 1.0 } else { 0.0 },
         };
-        tait_b[k] = (derived.c0 * derived.c0 * p.rho0 / 7.0) as f32;
-        if p.mobile && p.viscosity_pa_s > 0.0 && matches!(case.numerics.viscosity, Viscosity::Laminar) {
+        tait_b[k] = case::tait_b(derived.c0, p.rho0) as f32;
+        if p.mobile
+            && p.viscosity_pa_s > 0.0
+            && matches!(case.numerics.viscosity, Viscosity::Laminar)
+        {
             dt_visc = dt_visc.min(0.125 * h * h * p.rho0 / p.viscosity_pa_s);
         }
     }

@@ -4,7 +4,12 @@
 
 use crate::gpu::stage::{Access::*, StageSpec};
 
-const COMMON: &[&str] = &["common/params.wgsl", "common/kernel.wgsl", "common/eos.wgsl", "common/grid.wgsl"];
+const COMMON: &[&str] = &[
+    "common/params.wgsl",
+    "common/kernel.wgsl",
+    "common/eos.wgsl",
+    "common/grid.wgsl",
+];
 const WITH_NEIGHBOURS: &[&str] = &[
     "common/params.wgsl",
     "common/kernel.wgsl",
@@ -19,7 +24,11 @@ pub const GRID_CLEAR: StageSpec = StageSpec {
     name: "grid_clear",
     shader: "stages/grid_clear.wgsl",
     imports: &["common/params.wgsl"],
-    bindings: &[("params", 0, Uniform), ("cell_starts", 1, ReadWrite), ("cell_cursor", 2, ReadWrite)],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("cell_starts", 1, ReadWrite),
+        ("cell_cursor", 2, ReadWrite),
+    ],
     entry_points: &["grid_clear"],
     workgroup: 128,
 };
@@ -42,7 +51,11 @@ pub const PREFIX_SUM: StageSpec = StageSpec {
     name: "prefix_sum",
     shader: "stages/prefix_sum.wgsl",
     imports: &[],
-    bindings: &[("scan", 0, Uniform), ("data", 1, ReadWrite), ("block_sums", 2, ReadWrite)],
+    bindings: &[
+        ("scan", 0, Uniform),
+        ("data", 1, ReadWrite),
+        ("block_sums", 2, ReadWrite),
+    ],
     entry_points: &["prefix_sum_block", "prefix_sum_add"],
     workgroup: 256,
 };

@@ -8,7 +8,8 @@ use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::mem::offset_of;
 
 fn parse(stage_name: &str, src: &str) -> naga::Module {
-    naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{stage_name}: {}", e.emit_to_string(src)))
+    naga::front::wgsl::parse_str(src)
+        .unwrap_or_else(|e| panic!("{stage_name}: {}", e.emit_to_string(src)))
 }
 
 #[test]
@@ -34,7 +35,9 @@ fn declared_bindings_match_the_wgsl_globals() {
                 assert_eq!(b.group, 0, "{}: only group 0 is used", spec.name);
                 let access = match g.space {
                     naga::AddressSpace::Uniform => Access::Uniform,
-                    naga::AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => {
+                    naga::AddressSpace::Storage { access }
+                        if access.contains(naga::StorageAccess::STORE) =>
+                    {
                         Access::ReadWrite
                     }
                     naga::AddressSpace::Storage { .. } => Access::Read,
@@ -44,8 +47,11 @@ fn declared_bindings_match_the_wgsl_globals() {
             })
             .collect();
         found.sort_by_key(|b| b.1);
-        let declared: Vec<(String, u32, Access)> =
-            spec.bindings.iter().map(|(n, i, a)| (n.to_string(), *i, *a)).collect();
+        let declared: Vec<(String, u32, Access)> = spec
+            .bindings
+            .iter()
+            .map(|(n, i, a)| (n.to_string(), *i, *a))
+            .collect();
         assert_eq!(found, declared, "stage {}", spec.name);
     }
 }
@@ -54,13 +60,23 @@ fn declared_bindings_match_the_wgsl_globals() {
 fn entry_points_and_workgroup_sizes_match() {
     for spec in ALL {
         let module = parse(spec.name, &spec.source());
-        let names: Vec<&str> = module.entry_points.iter().map(|e| e.name.as_str()).collect();
+        let names: Vec<&str> = module
+            .entry_points
+            .iter()
+            .map(|e| e.name.as_str())
+            .collect();
         assert_eq!(names, spec.entry_points, "stage {}", spec.name);
         for e in &module.entry_points {
-            assert_eq!(e.workgroup_size, [spec.workgroup, 1, 1], "stage {} entry {}", spec.name, e.name);
+            assert_eq!(
+                e.workgroup_size,
+                [spec.workgroup, 1, 1],
+                "stage {} entry {}",
+                spec.name,
+                e.name
+            );
         }
         assert!(
-            spec.entry_points.iter().any(|e| *e == spec.name) || spec.entry_points.len() > 1,
+            spec.entry_points.contains(&spec.name) || spec.entry_points.len() > 1,
             "a single-entry stage is named after its entry point: {}",
             spec.name
         );
@@ -77,7 +93,10 @@ fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
         .1;
     match &ty.inner {
         naga::TypeInner::Struct { members, span } => (
-            members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
+            members
+                .iter()
+                .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                .collect(),
             *span,
         ),
         other => panic!("{name} is not a struct: {other:?}"),
@@ -85,12 +104,19 @@ fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
 }
 
 fn find(members: &[(String, u32)], name: &str) -> u32 {
-    members.iter().find(|m| m.0 == name).unwrap_or_else(|| panic!("no member {name}")).1
+    members
+        .iter()
+        .find(|m| m.0 == name)
+        .unwrap_or_else(|| panic!("no member {name}"))
+        .1
 }
 
 #[test]
 fn rust_mirrors_have_the_wgsl_layout() {
-    let forces = ALL.iter().find(|s| s.name == "forces_wcsph").expect("forces stage");
+    let forces = ALL
+        .iter()
+        .find(|s| s.name == "forces_wcsph")
+        .expect("forces stage");
     let module = parse("forces_wcsph", &forces.source());
     let (m, size) = wgsl_layout(&module, "SimParams");
     assert_eq!(size as usize, size_of::<SimParams>());
@@ -99,23 +125,69 @@ fn rust_mirrors_have_the_wgsl_layout() {
             $(assert_eq!(find(&$members, stringify!($field)) as usize, offset_of!($ty, $field), stringify!($field));)*
         };
     }
-    same!(SimParams, m, n_particles, n_cells, viscosity_mode, diffusion_mode, grid_dims, grid_origin, gravity,
-        h, kernel_ad, c0, eta2, delta_h_c0, alpha, cfl, dt_visc, dt_min, rho_ratio_max, vertical_axis, n_probes,
-        phases, tait_b);
+    same!(
+        SimParams,
+        m,
+        n_particles,
+        n_cells,
+        viscosity_mode,
+        diffusion_mode,
+        grid_dims,
+        grid_origin,
+        gravity,
+        h,
+        kernel_ad,
+        c0,
+        eta2,
+        delta_h_c0,
+        alpha,
+        cfl,
+        dt_visc,
+        dt_min,
+        rho_ratio_max,
+        vertical_axis,
+        n_probes,
+        phases,
+        tait_b
+    );
     let (m, size) = wgsl_layout(&module, "Phase");
     assert_eq!(size as usize, size_of::<PhaseParams>());
     same!(PhaseParams, m, rho0, mass, mu, mobile);
     let (m, size) = wgsl_layout(&module, "StepState");
     assert_eq!(size as usize, size_of::<StepState>());
-    same!(StepState, m, dt, t_rel, t_target, steps, dt_min_bits, status, last_dt, pad);
+    same!(
+        StepState,
+        m,
+        dt,
+        t_rel,
+        t_target,
+        steps,
+        dt_min_bits,
+        status,
+        last_dt,
+        pad
+    );
 
-    let observe = ALL.iter().find(|s| s.name == "observe_reduce").expect("observe stage");
+    let observe = ALL
+        .iter()
+        .find(|s| s.name == "observe_reduce")
+        .expect("observe stage");
     let module = parse("observe_reduce", &observe.source());
     let (m, size) = wgsl_layout(&module, "Extremes");
     assert_eq!(size as usize, size_of::<Extremes>());
-    same!(Extremes, m, front_key, max_speed_bits, max_rho_err_bits, fluid_count);
+    same!(
+        Extremes,
+        m,
+        front_key,
+        max_speed_bits,
+        max_rho_err_bits,
+        fluid_count
+    );
 
-    let scan = ALL.iter().find(|s| s.name == "prefix_sum").expect("scan stage");
+    let scan = ALL
+        .iter()
+        .find(|s| s.name == "prefix_sum")
+        .expect("scan stage");
     let (_, size) = wgsl_layout(&parse("prefix_sum", &scan.source()), "ScanInfo");
     assert_eq!(size as usize, size_of::<ScanInfo>());
 }

@@ -7,7 +7,9 @@ pub fn storage(gpu: &GpuContext, label: &str, bytes: u64) -> wgpu::Buffer {
     gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: bytes.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
 }
@@ -23,20 +25,33 @@ pub fn storage_init<T: bytemuck::Pod>(gpu: &GpuContext, label: &str, data: &[T])
 }
 
 pub fn uniform_init<T: bytemuck::Pod>(gpu: &GpuContext, label: &str, value: &T) -> wgpu::Buffer {
-    init(gpu, label, bytemuck::bytes_of(value), wgpu::BufferUsages::UNIFORM)
+    init(
+        gpu,
+        label,
+        bytemuck::bytes_of(value),
+        wgpu::BufferUsages::UNIFORM,
+    )
 }
 
 fn init(gpu: &GpuContext, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
-    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytes,
-        usage: usage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-    })
+    gpu.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: usage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        })
 }
 
 /// Copies `bytes` from the start of each buffer and waits for the result; one submission.
-pub fn read_buffers(gpu: &GpuContext, sources: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, GpuError> {
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+pub fn read_buffers(
+    gpu: &GpuContext,
+    sources: &[(&wgpu::Buffer, u64)],
+) -> Result<Vec<Vec<u8>>, GpuError> {
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
     let staging: Vec<wgpu::Buffer> = sources
         .iter()
         .map(|(src, bytes)| {
@@ -70,7 +85,9 @@ pub fn read_buffers(gpu: &GpuContext, sources: &[(&wgpu::Buffer, u64)]) -> Resul
     }
     let mut out = Vec::with_capacity(sources.len());
     for (buf, (_, bytes)) in staging.iter().zip(sources) {
-        let view = buf.get_mapped_range(..).map_err(|e| GpuError::Readback(e.to_string()))?;
+        let view = buf
+            .get_mapped_range(..)
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
         out.push(view[..*bytes as usize].to_vec());
         drop(view);
         buf.unmap();

@@ -126,7 +126,9 @@ impl GpuContext {
             name: info.name.clone(),
             backend: format!("{:?}", info.backend),
             device_type: format!("{:?}", info.device_type),
-            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
+            driver: format!("{} {}", info.driver, info.driver_info)
+                .trim()
+                .to_string(),
         };
         // Ask for everything the adapter offers: buffer sizes are the binding constraint.
         let limits = adapter.limits();
@@ -152,7 +154,9 @@ impl GpuContext {
 
     /// Fails with `TooLarge` if a storage buffer of `bytes` would exceed the adapter's limits.
     pub fn check_storage_size(&self, buffer: &str, bytes: u64) -> Result<(), GpuError> {
-        let limit = u64::from(self.limits.max_storage_buffer_binding_size)
+        let limit = self
+            .limits
+            .max_storage_buffer_binding_size
             .min(self.limits.max_buffer_size);
         if bytes > limit {
             return Err(GpuError::TooLarge {

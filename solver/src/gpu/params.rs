@@ -61,6 +61,22 @@ pub struct StepState {
     pub pad: u32,
 }
 
+impl StepState {
+    /// The state at the start of a chunk that ends `t_target` seconds later.
+    pub fn chunk(t_target: f32, last_dt: f32) -> StepState {
+        StepState {
+            dt: 0.0,
+            t_rel: 0.0,
+            t_target,
+            steps: 0,
+            dt_min_bits: f32::MAX.to_bits(),
+            status: 0,
+            last_dt,
+            pad: 0,
+        }
+    }
+}
+
 /// Mirrors `Extremes` in `shaders/stages/observe_reduce.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]

@@ -38,7 +38,11 @@ pub struct Stage {
 
 impl Stage {
     /// Compiles every entry point of the stage with the given override constants.
-    pub fn new(device: &wgpu::Device, spec: &'static StageSpec, constants: &[(&str, f64)]) -> Stage {
+    pub fn new(
+        device: &wgpu::Device,
+        spec: &'static StageSpec,
+        constants: &[(&str, f64)],
+    ) -> Stage {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(spec.name),
             source: wgpu::ShaderSource::Wgsl(spec.source().into()),
@@ -127,7 +131,13 @@ impl Stage {
     }
 
     /// Records one dispatch of entry point `entry` (index into `entry_points`) over `groups`.
-    pub fn record(&self, pass: &mut wgpu::ComputePass<'_>, entry: usize, bind: &wgpu::BindGroup, groups: u32) {
+    pub fn record(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        entry: usize,
+        bind: &wgpu::BindGroup,
+        groups: u32,
+    ) {
         if groups == 0 {
             return;
         }

@@ -76,14 +76,21 @@ pub struct Jitter(pub u64);
 
 impl Jitter {
     pub fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
     }
 }
 
 /// The case's lattice with every fluid particle displaced by up to 0.2 dp, given a velocity of
 /// up to `speed` and a density off rho0 by up to 1 %: no symmetry left to hide a wrong sign.
-pub fn perturbed(sim: &flume_solver::Simulation, speed: f32, seed: u64) -> flume_solver::case::Particles {
+pub fn perturbed(
+    sim: &flume_solver::Simulation,
+    speed: f32,
+    seed: u64,
+) -> flume_solver::case::Particles {
     let mut p = sim.initial_particles().clone();
     let dp = sim.case().numerics.dp_m as f32;
     let d = sim.case().dim();

@@ -1,0 +1,261 @@
+//! Tier 3: whole cases at CI size on the GPU, checked against physics and invariants.
+
+mod common;
+
+use flume_solver::case::Particles;
+use flume_solver::{Case, Simulation};
+use std::sync::Arc;
+
+fn case(name: &str) -> Case {
+    Case::from_path(&common::case_path(name)).expect("case parses")
+}
+
+/// After settling, the pressure at probes away from the walls follows rho g (H - z) within 2 %,
+/// H being the free surface the gauge measures (itself within dp / 2 of the filled height).
+/// 2 % is the bound; the residual is the slow sloshing mode left after the start,
+/// about 1 % here, which alpha = 0.02 damps only slowly.
+fn check_hydrostatic(name: &str, times_s: &[f64]) {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case(name);
+    let d = c.dim();
+    let rho_g = c.phases[0].rho0_kg_per_m3 * c.gravity_magnitude();
+    let filled = c.fluid_blocks[0].max_m[d - 1] + 0.5 * c.numerics.dp_m;
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    for &t in times_s {
+        sim.advance_to(t).expect("runs");
+        let obs = sim.observe().expect("observes");
+        let level = obs.gauges[0].level_m.expect("gauge in water");
+        assert!(
+            (level - filled).abs() <= 0.5 * c.numerics.dp_m,
+            "{name} t={t}: free surface {level:.5} m, filled to {filled:.5} m"
+        );
+        for (probe, cfg) in obs.probes.iter().zip(&c.observations.pressure_probes) {
+            let z = cfg.position_m[d - 1];
+            let expected = rho_g * (level - z);
+            let p = probe.pressure_pa.expect("probe in water");
+            let err = p / expected - 1.0;
+            eprintln!(
+                "{name} t={t:.2} z={z:.3}: p = {p:.1} Pa, rho g (H - z) = {expected:.1} Pa ({:+.2} %)",
+                err * 100.0
+            );
+            assert!(
+                err.abs() <= 0.02,
+                "{name} t={t} probe {}: {:+.2} %",
+                cfg.name,
+                err * 100.0
+            );
+        }
+    }
+}
+
+#[test]
+fn hydrostatic_tank_2d_pressure_follows_depth() {
+    check_hydrostatic("tests/cases/hydrostatic_2d.yaml", &[0.3, 0.35, 0.4]);
+}
+
+#[test]
+fn hydrostatic_tank_3d_pressure_follows_depth() {
+    check_hydrostatic("tests/cases/hydrostatic_3d.yaml", &[0.2, 0.25]);
+}
+
+fn read_front(path: &str) -> Vec<(f64, f64)> {
+    std::fs::read_to_string(common::validation_path(path))
+        .expect("validation data")
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| {
+            let mut it = l
+                .split(',')
+                .map(|v| v.trim().parse::<f64>().expect("number"));
+            (it.next().expect("T"), it.next().expect("Z/a"))
+        })
+        .collect()
+}
+
+fn interpolate(curve: &[(f64, f64)], t: f64) -> f64 {
+    let k = curve.partition_point(|p| p.0 < t).clamp(1, curve.len() - 1);
+    let (t0, z0) = curve[k - 1];
+    let (t1, z1) = curve[k];
+    z0 + (z1 - z0) * (t - t0) / (t1 - t0)
+}
+
+/// Particles must stay in the tank: inside its side walls and above its floor, allowing one
+/// dp of the wall's own thickness.
+fn assert_in_tank(c: &Case, p: &Particles) {
+    let d = c.dim();
+    let dp = c.numerics.dp_m as f32;
+    for i in 0..p.len() {
+        let x = p.positions[i];
+        for k in 0..d {
+            let lo = c.domain.min_m[k] as f32 - dp;
+            assert!(
+                x[k] >= lo,
+                "particle {i} left the tank through the {k}-min face: {x:?}"
+            );
+            if k < d - 1 {
+                assert!(
+                    x[k] <= c.domain.max_m[k] as f32 + dp,
+                    "particle {i} left through the {k}-max face: {x:?}"
+                );
+            }
+            assert!(x[k].is_finite());
+        }
+    }
+}
+
+/// Mass is carried by particles of fixed mass: it is conserved exactly when no particle is
+/// lost, duplicated or changes phase. Checks that every id is present with its phase.
+fn assert_mass_conserved(sim: &Simulation, now: &Particles) {
+    let init = sim.initial_particles();
+    assert_eq!(now.len(), init.len());
+    let mass = |p: &Particles| -> f64 {
+        (0..p.len())
+            .map(|i| sim.derived().phases[p.phase(i) as usize].mass)
+            .sum()
+    };
+    for i in 0..init.len() {
+        assert_eq!(
+            now.phase(i),
+            init.phase(i),
+            "particle {i} changed phase or is missing"
+        );
+    }
+    assert_eq!(mass(now), mass(init), "total mass");
+}
+
+/// Dam break of a column twice as high as wide against Martin & Moyce (1952), n^2 = 2.
+/// The experiment's time origin is uncertain by the removal of the gate, and the simulated
+/// front leads their data by about 0.1 in T at the start (Z/a 1.35 against 1.25 at T = 0.85),
+/// as in most published SPH and VOF comparisons. So the test fits one time shift dT in
+/// [0, 0.3] (0.3 is 16 ms for their 2.25 in column), states it, and then requires every
+/// measured point with T <= 2.5 of both column sizes within 5 % of the simulated front.
+/// Without the shift the errors are printed too.
+#[test]
+fn dambreak_front_follows_martin_moyce() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("../launch_configs/dambreak_water.yaml");
+    // The coarsest resolution that passes: a / dp = 25.
+    c.numerics.dp_m = 0.004;
+    let a = c.fluid_blocks[0].max_m[0] - c.fluid_blocks[0].min_m[0];
+    let scale = (2.0 * c.gravity_magnitude() / a).sqrt();
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    let mut curve = vec![(0.0, sim.observe().expect("observes").front_m / a)];
+    let steps = 52;
+    for k in 1..=steps {
+        let t_dimless = 2.6 * k as f64 / steps as f64;
+        sim.advance_to(t_dimless / scale).expect("runs");
+        curve.push((t_dimless, sim.observe().expect("observes").front_m / a));
+    }
+    let mut data = read_front("dambreak_front_position/martin_moyce1952_n2_2_a1.125in.csv");
+    data.extend(read_front(
+        "dambreak_front_position/martin_moyce1952_n2_2_a2.25in.csv",
+    ));
+    data.retain(|(t, _)| *t <= 2.5);
+    assert!(data.len() >= 6);
+    let worst = |shift: f64| -> f64 {
+        data.iter()
+            .map(|(t, z)| (interpolate(&curve, t - shift) / z - 1.0).abs())
+            .fold(0.0, f64::max)
+    };
+    let (shift, err) = (0..=30)
+        .map(|k| 0.01 * k as f64)
+        .map(|s| (s, worst(s)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("shifts");
+    for (t, z) in &data {
+        eprintln!(
+            "T = {t:.3}: Martin & Moyce Z/a = {z:.3}; SPH {:.3} ({:+.1} %), with dT = {shift:.2}: {:.3} ({:+.1} %)",
+            interpolate(&curve, *t),
+            (interpolate(&curve, *t) / z - 1.0) * 100.0,
+            interpolate(&curve, t - shift),
+            (interpolate(&curve, t - shift) / z - 1.0) * 100.0
+        );
+    }
+    assert!(
+        err <= 0.05,
+        "worst front error {:.1} % even with the best time shift {shift}",
+        err * 100.0
+    );
+    let p = sim.read_particles().expect("readback");
+    assert_in_tank(&c, &p);
+    assert_mass_conserved(&sim, &p);
+}
+
+/// The same case run twice on the same adapter gives the same bits: neighbour order is fixed
+/// by the (cell, id) sort and every reduction is a min or max.
+#[test]
+fn dambreak_is_bit_identical_run_to_run_and_loses_nothing() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("../launch_configs/dambreak_water.yaml");
+    c.numerics.dp_m = 0.005;
+    let run = || {
+        let mut sim = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+        sim.advance_to(0.04).expect("runs");
+        let p = sim.read_particles().expect("readback");
+        assert_mass_conserved(&sim, &p);
+        assert_in_tank(&c, &p);
+        (p, sim.steps())
+    };
+    let (a, steps_a) = run();
+    let (b, steps_b) = run();
+    assert_eq!(steps_a, steps_b);
+    let bits = |p: &Particles| -> Vec<u32> {
+        p.positions
+            .iter()
+            .chain(&p.vel_rho)
+            .flat_map(|v| v.map(f32::to_bits))
+            .collect()
+    };
+    assert!(bits(&a) == bits(&b), "two runs differ");
+    assert_ne!(
+        bits(&a),
+        bits(&flume_solver::case::generate(
+            &c,
+            &flume_solver::case::derive(&c)
+        )),
+        "nothing moved"
+    );
+}
+
+#[test]
+fn a_case_larger_than_the_adapter_allows_fails_before_allocating() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("tests/cases/hydrostatic_3d.yaml");
+    // Enough particles to pass the per-binding limit of this adapter, whatever it is.
+    let limit = gpu
+        .limits
+        .max_storage_buffer_binding_size
+        .min(gpu.limits.max_buffer_size) as f64;
+    let volume = c.fluid_blocks[0].max_m.iter().product::<f64>();
+    c.numerics.dp_m = (volume / (2.0 * limit / 16.0)).cbrt();
+    let err = match Simulation::new(gpu, &c) {
+        Ok(_) => panic!(
+            "a case of {} particles was accepted",
+            flume_solver::case::count(&c)
+        ),
+        Err(e) => e.to_string(),
+    };
+    eprintln!("{err}");
+    assert!(
+        err.contains("MiB") && (err.contains("per storage buffer") || err.contains("32-bit")),
+        "unclear error: {err}"
+    );
+}
+
+#[test]
+fn an_unknown_adapter_name_lists_the_available_ones() {
+    let Some(_gpu) = common::gpu() else { return };
+    let _l = common::gpu_lock();
+    let err = match flume_solver::GpuContext::with_adapter(Some("no-such-adapter-xyz")) {
+        Ok(_) => panic!("matched a nonexistent adapter"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("FLUME_TWIN_ADAPTER") && err.contains("available:"),
+        "{err}"
+    );
+}

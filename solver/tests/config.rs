@@ -1,0 +1,173 @@
+//! Case files: every shipped case parses, generation matches the documented counts, and a
+//! malformed file fails with an error naming the field and the reason. No GPU needed.
+
+use flume_solver::case::{self, WALL_PHASE};
+use flume_solver::{Case, ConfigError};
+use std::path::Path;
+
+fn launch_config(name: &str) -> Case {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../launch_configs")
+        .join(name);
+    Case::from_path(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const DAMBREAK: &str = include_str!("../../launch_configs/dambreak_water.yaml");
+
+fn refused(text: &str) -> (String, String) {
+    match Case::from_yaml(text, "test.yaml") {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(ConfigError::Parse { field, reason, .. })
+        | Err(ConfigError::Invalid { field, reason, .. }) => (field, reason),
+        Err(e) => panic!("unexpected error {e}"),
+    }
+}
+
+#[test]
+fn every_shipped_case_parses() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).expect("launch_configs") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "yaml") {
+            Case::from_path(&path).unwrap_or_else(|e| panic!("{e}"));
+            n += 1;
+        }
+    }
+    assert!(n >= 2);
+}
+
+#[test]
+fn dualsphysics_dambreak_copy_has_its_particle_counts() {
+    let c = launch_config("dsph_dambreak_val2d.yaml");
+    let d = case::derive(&c);
+    let p = case::generate(&c, &d);
+    let walls = (0..p.len()).filter(|&i| p.phase(i) == WALL_PHASE).count();
+    assert_eq!(p.len(), 21_001);
+    assert_eq!(walls, 1_001);
+    assert_eq!(case::count(&c), 21_001);
+    // h = sqrt(2) dp and c0 = 20 sqrt(g 2 m), as DualSPHysics computes them.
+    assert!((d.h - 2f64.sqrt() * 0.01).abs() < 1e-12);
+    assert!((d.c0 - 20.0 * (9.81f64 * 2.0).sqrt()).abs() < 1e-9);
+    // Every particle on the dp lattice, ids in order.
+    assert!(p.ids.iter().enumerate().all(|(i, id)| *id as usize == i));
+}
+
+#[test]
+fn count_matches_generate_for_every_case() {
+    for name in ["dambreak_water.yaml", "dsph_dambreak_val2d.yaml"] {
+        let c = launch_config(name);
+        assert_eq!(
+            case::count(&c) as usize,
+            case::generate(&c, &case::derive(&c)).len(),
+            "{name}"
+        );
+    }
+    for name in ["hydrostatic_2d.yaml", "hydrostatic_3d.yaml"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/cases")
+            .join(name);
+        let c = Case::from_path(&path).expect("parses");
+        assert_eq!(
+            case::count(&c) as usize,
+            case::generate(&c, &case::derive(&c)).len(),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn initial_density_is_hydrostatic() {
+    let c = launch_config("dambreak_water.yaml");
+    let d = case::derive(&c);
+    let p = case::generate(&c, &d);
+    let b = d.c0 * d.c0 * 1000.0 / 7.0;
+    for i in 0..p.len() {
+        let depth = (0.2 - f64::from(p.positions[i][1])).max(0.0);
+        let under_column = f64::from(p.positions[i][0]) <= 0.1 + 2.0 * c.numerics.dp_m;
+        let expected = if p.phase(i) != WALL_PHASE || under_column {
+            1000.0 * (1.0 + 1000.0 * 9.81 * depth / b).powf(1.0 / 7.0)
+        } else {
+            1000.0
+        };
+        assert!(
+            (f64::from(p.vel_rho[i][3]) - expected).abs() < 1e-3,
+            "particle {i}: {:?}",
+            p.vel_rho[i]
+        );
+    }
+}
+
+#[test]
+fn unknown_field_is_refused_by_name() {
+    let text = DAMBREAK.replace("  cfl: 0.2\n", "  cfl: 0.2\n  cfll: 0.3\n");
+    let (field, reason) = refused(&text);
+    assert_eq!(field, "numerics.cfll");
+    assert!(reason.contains("unknown field `cfll`"), "{reason}");
+}
+
+#[test]
+fn invalid_values_are_refused_with_field_and_reason() {
+    let cases = [
+        (
+            "  dp_m: 0.0025\n",
+            "  dp_m: -0.0025\n",
+            "numerics.dp_m",
+            "positive",
+        ),
+        ("  cfl: 0.2\n", "  cfl: 1.5\n", "numerics.cfl", "(0, 1]"),
+        ("dimension: 2\n", "dimension: 4\n", "dimension", "2 or 3"),
+        (
+            "  - phase: water\n",
+            "  - phase: sand\n",
+            "fluid_blocks[0].phase",
+            "no phase named `sand`",
+        ),
+        (
+            "  sound_speed: { coefsound: 20.0 }\n",
+            "  sound_speed: { coefsound: 20.0, c0_m_per_s: 30.0 }\n",
+            "numerics.sound_speed",
+            "exactly one",
+        ),
+        (
+            "    - { name: mid_tank, position_m: [0.3] }\n",
+            "    - { name: mid_tank, position_m: [0.9] }\n",
+            "observations.gauges[1].position_m",
+            "inside the domain",
+        ),
+        (
+            "gravity_m_per_s2: [0.0, -9.81]\n",
+            "gravity_m_per_s2: [0.0, 9.81]\n",
+            "gravity_m_per_s2",
+            "down",
+        ),
+        (
+            "    max_m: [0.1, 0.2]\n",
+            "    max_m: [0.1, 0.5]\n",
+            "fluid_blocks[0]",
+            "inside the domain",
+        ),
+    ];
+    for (from, to, field, reason_part) in cases {
+        assert!(DAMBREAK.contains(from), "test text out of date: {from}");
+        let (f, r) = refused(&DAMBREAK.replace(from, to));
+        assert_eq!(f, field, "for {to:?}: {r}");
+        assert!(r.contains(reason_part), "for {to:?}: {r}");
+    }
+}
+
+#[test]
+fn wrong_types_and_missing_fields_are_named() {
+    let (f, r) = refused(&DAMBREAK.replace("  dp_m: 0.0025\n", "  dp_m: fine\n"));
+    assert_eq!(f, "numerics.dp_m");
+    assert!(r.contains("invalid type"), "{r}");
+    let (f, r) = refused(&DAMBREAK.replace("  dp_m: 0.0025\n", ""));
+    assert_eq!(f, "numerics");
+    assert!(r.contains("missing field `dp_m`"), "{r}");
+    let (f, r) = refused(&DAMBREAK.replace(
+        "method: artificial, alpha: 0.02",
+        "method: sps, alpha: 0.02",
+    ));
+    assert!(f.starts_with("numerics.viscosity"), "{f}");
+    assert!(r.contains("unknown variant `sps`"), "{r}");
+}
