@@ -1,0 +1,288 @@
+//! `flume-twin bench`: throughput (particle-steps/s) and real-time factor on this machine.
+//!
+//! Each measurement warms up, estimates the cost of a step, then times whole steps for about
+//! `--steps-seconds` of wall time. Nothing here asserts on speed: the figures are for a log.
+
+use crate::cli::BenchArgs;
+use crate::table::{Table, sci, sig};
+use anyhow::{Context, Result, bail};
+use flume_solver::{Case, GpuContext, Simulation};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// DualSPHysics 5.4 on CaseDambreakVal2D, CPU, 2 OpenMP threads, particle-steps/s.
+const DSPH_VERLET: f64 = 1.77e6;
+const DSPH_SYMPLECTIC: f64 = 0.95e6;
+
+/// Steps the solver records into the first submission of every `advance_to`, even when fewer
+/// are needed (a finished chunk's extra steps still cost a sort and the force passes).
+const MIN_CHUNK_STEPS: f64 = 8.0;
+
+/// Spacing of the synthetic cases, m: the tank grows with the particle count, not the resolution.
+const BENCH_DP_M: f64 = 0.01;
+
+/// One timed stretch of a run.
+struct Measurement {
+    particles: usize,
+    fluid: usize,
+    steps: u64,
+    wall_s: f64,
+    /// Simulated time covered by the timed stretch, from `start_s`.
+    sim_s: f64,
+    start_s: f64,
+}
+
+impl Measurement {
+    fn steps_per_s(&self) -> f64 {
+        self.steps as f64 / self.wall_s
+    }
+    fn particle_steps_per_s(&self) -> f64 {
+        self.particles as f64 * self.steps_per_s()
+    }
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    if !(args.steps_seconds.is_finite() && args.steps_seconds > 0.0) {
+        bail!(
+            "--steps-seconds must be a positive number of seconds, got {}",
+            args.steps_seconds
+        );
+    }
+    if let Some(n) = args.ladder.iter().find(|n| **n < 100) {
+        bail!("--ladder: {n} particles is too few for a dam break; use at least 100");
+    }
+    // Load the reference case first so a wrong path fails before minutes of timing.
+    let reference = Case::from_path(&args.case)
+        .context("cannot load the reference case (run from the repository root or pass --case)")?;
+    let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
+    println!("adapter: {}", gpu.adapter);
+    println!(
+        "each figure times whole steps for about {} s of wall time, after a warm-up",
+        args.steps_seconds
+    );
+    let mut failures = 0;
+
+    println!();
+    println!(
+        "synthetic 2-D dam breaks: a water column filling 1/4 of the tank, dp = {BENCH_DP_M} m, \
+         the numerics of {}",
+        reference.name
+    );
+    let mut table = Table::new([
+        "particles",
+        "fluid",
+        "steps",
+        "wall s",
+        "steps/s",
+        "particle-steps/s",
+        "adapter",
+    ]);
+    let mut errors = Vec::new();
+    for &n in &args.ladder {
+        let result = dam_break_case(n).and_then(|case| measure(&gpu, &case, args.steps_seconds));
+        match result {
+            Ok(m) => table.row([
+                m.particles.to_string(),
+                m.fluid.to_string(),
+                m.steps.to_string(),
+                format!("{:.2}", m.wall_s),
+                sig(m.steps_per_s()),
+                sci(m.particle_steps_per_s()),
+                gpu.adapter.name.clone(),
+            ]),
+            Err(e) => {
+                failures += 1;
+                table.row([format!("~{n}"), "failed".to_string()]);
+                errors.push(format!("~{n} particles: {e:#}"));
+            }
+        }
+    }
+    print!("{table}");
+    for e in &errors {
+        println!("error: {e}");
+    }
+
+    println!();
+    println!("case {} ({})", reference.name, args.case.display());
+    match measure(&gpu, &reference, args.steps_seconds) {
+        Ok(m) => print_reference(&m, &reference, &gpu.adapter.name),
+        Err(e) => {
+            failures += 1;
+            println!("error: {e:#}");
+        }
+    }
+    if failures > 0 {
+        bail!(
+            "{failures} of {} measurements failed (see above)",
+            args.ladder.len() + 1
+        );
+    }
+    Ok(())
+}
+
+fn print_reference(m: &Measurement, case: &Case, adapter: &str) {
+    let mut table = Table::new([
+        "particles",
+        "fluid",
+        "steps",
+        "wall s",
+        "steps/s",
+        "particle-steps/s",
+        "adapter",
+    ]);
+    table.row([
+        m.particles.to_string(),
+        m.fluid.to_string(),
+        m.steps.to_string(),
+        format!("{:.2}", m.wall_s),
+        sig(m.steps_per_s()),
+        sci(m.particle_steps_per_s()),
+        adapter.to_string(),
+    ]);
+    print!("{table}");
+    let rate = m.particle_steps_per_s();
+    println!("against DualSPHysics 5.4 on the CPU (2 OpenMP threads), same case:");
+    println!(
+        "  Verlet      {} particle-steps/s: ratio {:.3}",
+        sci(DSPH_VERLET),
+        rate / DSPH_VERLET
+    );
+    println!(
+        "  symplectic  {} particle-steps/s: ratio {:.3}",
+        sci(DSPH_SYMPLECTIC),
+        rate / DSPH_SYMPLECTIC
+    );
+    println!(
+        "  This solver's step is symplectic (two force passes), so the symplectic ratio is the\n  \
+         like-for-like one; a Verlet step costs DualSPHysics one force pass, about half as much."
+    );
+    println!(
+        "real-time factor: {} simulated s per wall s (t = {:.4} .. {:.4} s of the {} s case)",
+        sig(m.sim_s / m.wall_s),
+        m.start_s,
+        m.start_s + m.sim_s,
+        case.time.end_s
+    );
+}
+
+/// A 2-D dam break with about `fluid` fluid particles: a column a wide and 2a high against the
+/// left wall of a tank 3.2a long and 2.5a high (the column fills 1/4 of it), one wall layer, and
+/// the numerics of DualSPHysics' CaseDambreakVal2D.
+pub fn dam_break_case(fluid: u64) -> Result<Case> {
+    // The block fills lattice points (0, a] x (0, 2a]: m columns of 2m points.
+    let m = ((fluid as f64 / 2.0).sqrt().round() as u64).max(4);
+    let dp = BENCH_DP_M;
+    let a = m as f64 * dp;
+    let length = (3.2 * m as f64).ceil() * dp;
+    let height = (2.5 * m as f64).ceil() * dp;
+    let column = 2.0 * a;
+    let yaml = format!(
+        "name: bench_{fluid}
+dimension: 2
+domain: {{ min_m: [0.0, 0.0], max_m: [{length}, {height}] }}
+walls: {{ layers: 1 }}
+phases:
+  - {{ name: water, rho0_kg_per_m3: 1000.0, viscosity_pa_s: 1.0e-3 }}
+fluid_blocks:
+  - {{ phase: water, min_m: [0.0, 0.0], max_m: [{a}, {column}] }}
+numerics:
+  dp_m: {dp}
+  coefh: 1.0
+  cfl: 0.2
+  sound_speed: {{ coefsound: 20.0 }}
+  density_diffusion: {{ method: fourtakas2019, delta: 0.1 }}
+  viscosity: {{ method: artificial, alpha: 0.02 }}
+gravity_m_per_s2: [0.0, -9.81]
+time: {{ end_s: 10.0, output_interval_s: 0.01 }}
+"
+    );
+    Case::from_yaml(&yaml, "bench")
+        .with_context(|| format!("the synthetic case for {fluid} particles is invalid"))
+}
+
+/// Times `case` on `gpu` for about `wall_target_s` after a warm-up.
+fn measure(gpu: &Arc<GpuContext>, case: &Case, wall_target_s: f64) -> Result<Measurement> {
+    let name = &case.name;
+    let mut sim =
+        Simulation::new(Arc::clone(gpu), case).with_context(|| format!("cannot set up {name}"))?;
+    let derived = sim.derived();
+    // The acoustic CFL limit: the real step is never larger, so the warm-up is at least 4 steps.
+    let dt_guess = case.numerics.cfl * derived.h / derived.c0;
+    sim.advance_to(4.0 * dt_guess)
+        .with_context(|| format!("{name}: warm-up failed"))?;
+
+    // Every `advance_to` costs at least MIN_CHUNK_STEPS steps of GPU time (the solver's first
+    // submission), used or not, so no stretch timed here is shorter than that.
+    let min_stretch_s = |sim: &Simulation| MIN_CHUNK_STEPS * sim.last_dt_s().max(dt_guess);
+
+    // Estimate wall s per simulated s from ever longer stretches until one is long enough
+    // to trust (a tenth of the target, or half a second on a slow adapter).
+    let mut stretch_s = min_stretch_s(&sim);
+    let wall_per_sim = loop {
+        let t0 = sim.time_s();
+        let started = Instant::now();
+        sim.advance_to(t0 + stretch_s)
+            .with_context(|| format!("{name}: warm-up failed"))?;
+        let wall = started.elapsed().as_secs_f64();
+        if wall >= (0.1 * wall_target_s).min(0.5) {
+            break wall / stretch_s;
+        }
+        stretch_s *= 4.0;
+    };
+
+    // Advance in quarters of the estimate until the target wall time has passed: the step
+    // shrinks as the column collapses, so one stretch of the estimate could overshoot.
+    let start_s = sim.time_s();
+    let steps0 = sim.steps();
+    let started = Instant::now();
+    while started.elapsed().as_secs_f64() < wall_target_s {
+        let piece_s = (0.25 * wall_target_s / wall_per_sim).max(2.0 * min_stretch_s(&sim));
+        let target = sim.time_s() + piece_s;
+        sim.advance_to(target)
+            .with_context(|| format!("{name}: failed at t = {:.4} s", sim.time_s()))?;
+    }
+    let wall_s = started.elapsed().as_secs_f64();
+    Ok(Measurement {
+        particles: sim.particle_count(),
+        fluid: sim.fluid_count(),
+        steps: sim.steps() - steps0,
+        wall_s,
+        sim_s: sim.time_s() - start_s,
+        start_s,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flume_solver::case::{WALL_PHASE, derive, generate};
+    use std::path::Path;
+
+    /// Fluid particles a case holds, counted on the CPU.
+    fn fluid_of(case: &Case) -> usize {
+        let particles = generate(case, &derive(case));
+        (0..particles.len())
+            .filter(|&i| particles.phase(i) != WALL_PHASE)
+            .count()
+    }
+
+    #[test]
+    fn synthetic_cases_hold_about_the_asked_fluid_count() {
+        for n in [4000u64, 16000, 64000] {
+            let case = dam_break_case(n).unwrap();
+            let fluid = fluid_of(&case) as f64;
+            assert!(
+                (fluid / n as f64 - 1.0).abs() < 0.02,
+                "{n} asked, {fluid} made"
+            );
+        }
+    }
+
+    #[test]
+    fn reference_case_file_parses() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../launch_configs/dsph_dambreak_val2d.yaml");
+        let case = Case::from_path(&path).unwrap();
+        assert_eq!(case.dimension, 2);
+    }
+}

@@ -1,0 +1,222 @@
+//! `flume-twin simulate`: an offline run of a case, interval by interval.
+
+use crate::cli::SimulateArgs;
+use crate::output::{csv::GaugeCsv, vtk};
+use crate::table::{Table, sci, sig};
+use anyhow::{Context, Result, bail};
+use flume_solver::{Case, GpuContext, Observations, Simulation, SolverError};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::fs::{self, File};
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The progress bar counts simulated microseconds: an integer position with ample resolution.
+const TICKS_PER_S: f64 = 1e6;
+
+pub fn run(args: &SimulateArgs) -> Result<()> {
+    // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
+    let case = Case::from_path(&args.case).context("the case file was refused")?;
+    let end_s = match args.until {
+        Some(t) if !(t.is_finite() && t > 0.0) => {
+            bail!("--until must be a positive time in s, got {t}")
+        }
+        Some(t) => t,
+        None => case.time.end_s,
+    };
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&case.name));
+    let snapshot_every = (!args.no_snapshots).then_some(args.snapshot_every);
+
+    let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
+    println!("adapter: {}", gpu.adapter);
+    let mut sim = Simulation::new(gpu, &case).context("cannot set up the simulation")?;
+    print_case(&args.case, &case, &sim);
+
+    let mut recorder = Recorder::create(&out_dir, &case, snapshot_every)?;
+    let interval_s = case.time.output_interval_s;
+    // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
+    let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;
+    println!(
+        "run: to t = {end_s} s, output every {interval_s} s ({intervals} intervals) -> {} ({})",
+        out_dir.display(),
+        match snapshot_every {
+            None => "no snapshots".to_string(),
+            Some(1) => "a snapshot every interval".to_string(),
+            Some(n) => format!("a snapshot every {n} intervals"),
+        }
+    );
+
+    let progress = progress_bar(end_s);
+    progress.set_message(format!("t = 0/{end_s} s"));
+    let started = Instant::now();
+    let mut last = recorder.record(&sim, 0)?;
+    for k in 1..=intervals {
+        let target_s = (k as f64 * interval_s).min(end_s);
+        if let Err(err) = sim.advance_to(target_s) {
+            progress.abandon();
+            if matches!(err, SolverError::BlowUp { .. }) {
+                // The broken state shows where it went wrong; losing it would waste the run.
+                if let Err(e) = recorder.snapshot(&sim, "particles_failed.vtk") {
+                    log::warn!("could not write the failed state: {e:#}");
+                }
+            }
+            return Err(err).context(format!(
+                "the simulation stopped; outputs up to t = {} s are in {}",
+                last.time_s,
+                out_dir.display()
+            ));
+        }
+        last = recorder.record(&sim, k)?;
+        let wall = started.elapsed().as_secs_f64();
+        progress.set_position((sim.time_s() * TICKS_PER_S) as u64);
+        progress.set_message(format!(
+            "t = {:.4}/{end_s} s, {:.0} steps/s",
+            sim.time_s(),
+            sim.steps() as f64 / wall
+        ));
+    }
+    progress.finish_and_clear();
+    let wall_s = started.elapsed().as_secs_f64();
+    print_summary(&sim, &last, wall_s);
+    Ok(())
+}
+
+fn print_case(path: &Path, case: &Case, sim: &Simulation) {
+    let derived = sim.derived();
+    println!(
+        "case: {} ({}-D) from {}",
+        case.name,
+        case.dimension,
+        path.display()
+    );
+    println!(
+        "particles: {} ({} fluid, {} wall)",
+        sim.particle_count(),
+        sim.fluid_count(),
+        sim.particle_count() - sim.fluid_count()
+    );
+    println!(
+        "h = {:.6} m, c0 = {:.3} m/s, dp = {} m",
+        derived.h, derived.c0, case.numerics.dp_m
+    );
+}
+
+fn progress_bar(end_s: f64) -> ProgressBar {
+    let bar = ProgressBar::new((end_s * TICKS_PER_S) as u64);
+    // A template typo is a programming error, caught the first time anyone runs simulate.
+    if let Ok(style) =
+        ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {msg}, ETA {eta}")
+    {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The files of a run: gauges.csv gets a row per output interval, and every
+/// `snapshot_every`-th interval k a snapshot `particles_kkkk.vtk`.
+struct Recorder {
+    dir: PathBuf,
+    csv_path: PathBuf,
+    csv: GaugeCsv<BufWriter<File>>,
+    snapshot_every: Option<u64>,
+}
+
+impl Recorder {
+    fn create(dir: &Path, case: &Case, snapshot_every: Option<u64>) -> Result<Recorder> {
+        fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let csv_path = dir.join("gauges.csv");
+        let obs = &case.observations;
+        let gauges: Vec<String> = obs.gauges.iter().map(|g| g.name.clone()).collect();
+        let probes: Vec<String> = obs.pressure_probes.iter().map(|p| p.name.clone()).collect();
+        let file = File::create(&csv_path)
+            .with_context(|| format!("cannot create {}", csv_path.display()))?;
+        let csv = GaugeCsv::new(BufWriter::new(file), &gauges, &probes)
+            .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        Ok(Recorder {
+            dir: dir.to_path_buf(),
+            csv_path,
+            csv,
+            snapshot_every,
+        })
+    }
+
+    /// Observes the state after output interval `k` and writes what is due.
+    fn record(&mut self, sim: &Simulation, k: u64) -> Result<Observations> {
+        let obs = sim
+            .observe()
+            .context("cannot read the observations back from the GPU")?;
+        self.csv
+            .row(&obs)
+            .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
+        if self.snapshot_every.is_some_and(|n| k.is_multiple_of(n)) {
+            self.snapshot(sim, &format!("particles_{k:04}.vtk"))?;
+        }
+        Ok(obs)
+    }
+
+    /// Writes to a temporary name first, so a crash never leaves a truncated snapshot behind.
+    fn snapshot(&self, sim: &Simulation, name: &str) -> Result<()> {
+        let particles = sim
+            .read_particles()
+            .context("cannot read the particles back from the GPU")?;
+        let path = self.dir.join(name);
+        let tmp = self.dir.join(format!("{name}.part"));
+        let title = format!(
+            "flume-twin {} t = {} s step {}",
+            sim.case().name,
+            sim.time_s(),
+            sim.steps()
+        );
+        let file =
+            File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+        vtk::write_particles(BufWriter::new(file), &title, &particles)
+            .and_then(|()| fs::rename(&tmp, &path))
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
+    let steps = sim.steps() as f64;
+    let particles = sim.particle_count() as f64;
+    let mut t = Table::new(["quantity", "value"]);
+    t.row([
+        "simulated time".to_string(),
+        format!("{:.6} s", sim.time_s()),
+    ]);
+    t.row([
+        "wall time (with output)".to_string(),
+        format!("{wall_s:.3} s"),
+    ]);
+    t.row(["steps".to_string(), sim.steps().to_string()]);
+    t.row([
+        "particle-steps/s".to_string(),
+        sci(particles * steps / wall_s),
+    ]);
+    t.row(["steps/s".to_string(), sig(steps / wall_s)]);
+    t.row([
+        "real-time factor".to_string(),
+        format!("{} (sim s per wall s)", sig(sim.time_s() / wall_s)),
+    ]);
+    for g in &last.gauges {
+        let level = g.level_m.map_or("dry".to_string(), |v| format!("{v:.4} m"));
+        t.row([format!("gauge {}", g.name), level]);
+    }
+    for p in &last.probes {
+        let pressure = p
+            .pressure_pa
+            .map_or("dry".to_string(), |v| format!("{v:.1} Pa"));
+        t.row([format!("probe {}", p.name), pressure]);
+    }
+    t.row(["front".to_string(), format!("{:.4} m", last.front_m)]);
+    t.row([
+        "max density error".to_string(),
+        format!("{:.3e}", last.max_density_error),
+    ]);
+    println!();
+    print!("{t}");
+}

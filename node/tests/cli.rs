@@ -1,0 +1,284 @@
+//! The flume-twin binary as a user runs it: bad case files, a short simulate run and its
+//! output files, and the missing-adapter message.
+//!
+//! GPU tests skip with a note when no adapter is found, except under CI=true (CI has lavapipe),
+//! where a missing adapter is a failure. They run one at a time: lavapipe uses every core.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::{Mutex, MutexGuard};
+
+const BIN: &str = env!("CARGO_BIN_EXE_flume-twin");
+
+static GPU: Mutex<()> = Mutex::new(());
+
+fn repo_file(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+}
+
+/// A fresh, empty directory for one test's files.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli")
+        .join(name);
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn flume_twin(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().unwrap()
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Holds the GPU lock if an adapter is there; None (after a note) if the test should skip.
+fn gpu() -> Option<MutexGuard<'static, ()>> {
+    let guard = GPU.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    match flume_solver::GpuContext::new() {
+        Ok(_) => Some(guard),
+        Err(e) if std::env::var("CI").as_deref() == Ok("true") => {
+            panic!("CI=true and no GPU adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("note: skipping a GPU test, no adapter: {e}");
+            None
+        }
+    }
+}
+
+/// The verification case with one textual change, written to `dir`.
+fn edited_case(dir: &Path, from: &str, to: &str) -> PathBuf {
+    let original = fs::read_to_string(repo_file("launch_configs/dambreak_water.yaml")).unwrap();
+    assert!(
+        original.contains(from),
+        "the case file no longer contains {from:?}"
+    );
+    let path = dir.join("case.yaml");
+    fs::write(&path, original.replacen(from, to, 1)).unwrap();
+    path
+}
+
+#[test]
+fn unknown_field_is_refused_by_name() {
+    let dir = scratch("unknown_field");
+    let case = edited_case(&dir, "  coefh: 1.2\n", "  coefh: 1.2\n  bogus_knob: 3\n");
+    let out = flume_twin(&[
+        "simulate",
+        case.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "accepted an unknown field; stderr: {stderr}"
+    );
+    assert!(
+        stderr.contains("bogus_knob"),
+        "stderr does not name the field: {stderr}"
+    );
+    assert!(
+        stderr.contains("numerics"),
+        "stderr does not name the section: {stderr}"
+    );
+    assert!(
+        !dir.join("out").exists(),
+        "a refused case must not create outputs"
+    );
+}
+
+#[test]
+fn negative_dp_is_refused_by_name() {
+    let dir = scratch("negative_dp");
+    let case = edited_case(&dir, "dp_m: 0.0025", "dp_m: -0.0025");
+    let out = flume_twin(&[
+        "simulate",
+        case.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "accepted a negative dp; stderr: {stderr}"
+    );
+    assert!(
+        stderr.contains("numerics.dp_m"),
+        "stderr does not name the field: {stderr}"
+    );
+}
+
+#[test]
+fn missing_case_file_is_reported() {
+    let dir = scratch("missing_case");
+    let missing = dir.join("no_such_case.yaml");
+    let out = flume_twin(&["simulate", missing.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("no_such_case.yaml"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
+fn missing_adapter_says_how_to_get_one() {
+    let dir = scratch("no_adapter");
+    // WGPU_BACKEND=vulkan keeps wgpu off GL (llvmpipe would answer there); the two loader
+    // variables (new and legacy name) point the Vulkan loader at no driver at all.
+    let out = Command::new(BIN)
+        .args([
+            "simulate",
+            repo_file("launch_configs/dambreak_water.yaml")
+                .to_str()
+                .unwrap(),
+        ])
+        .args([
+            "--until",
+            "0.001",
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .output()
+        .unwrap();
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "found an adapter with no driver; stdout: {}",
+        text(&out.stdout)
+    );
+    assert!(
+        stderr.contains("mesa-vulkan-drivers"),
+        "no install hint: {stderr}"
+    );
+}
+
+#[test]
+fn short_run_writes_gauges_and_snapshots() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = scratch("short_run");
+    let out_dir = dir.join("out");
+    let out = flume_twin(&[
+        "simulate",
+        repo_file("launch_configs/dambreak_water.yaml")
+            .to_str()
+            .unwrap(),
+        "--until",
+        "0.01",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stdout = text(&out.stdout);
+    assert!(
+        out.status.success(),
+        "simulate failed: {}\n{stdout}",
+        text(&out.stderr)
+    );
+    assert!(stdout.starts_with("adapter: "), "{stdout}");
+    assert!(stdout.contains("real-time factor"), "no summary: {stdout}");
+
+    let csv = fs::read_to_string(out_dir.join("gauges.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    assert_eq!(
+        header,
+        "time_s,step,dt_s,front_m,max_speed_m_per_s,max_density_error,near_wall_m,mid_tank_m,toe_pa"
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert!(rows.len() >= 2, "{csv}");
+    for row in &rows {
+        assert_eq!(row.split(',').count(), 9, "row {row:?}");
+    }
+    let last_time: f64 = rows
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (last_time - 0.01).abs() < 1e-12,
+        "last row at t = {last_time}"
+    );
+
+    let particles: usize = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("particles: "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("a `particles: N` line");
+    let mut snapshots: Vec<PathBuf> = fs::read_dir(&out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "vtk"))
+        .collect();
+    snapshots.sort();
+    assert!(!snapshots.is_empty(), "no .vtk in {}", out_dir.display());
+    check_vtk_header(&fs::read(snapshots.last().unwrap()).unwrap(), particles);
+}
+
+#[test]
+fn blow_up_exits_non_zero_and_keeps_outputs() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = scratch("blow_up");
+    // c0 = 1.5 m/s is far below 10 times the flow speed: densities run away within ~0.02 s.
+    let case = edited_case(
+        &dir,
+        "sound_speed: { coefsound: 20.0 }",
+        "sound_speed: { c0_m_per_s: 1.5 }",
+    );
+    let out_dir = dir.join("out");
+    let out = flume_twin(&[
+        "simulate",
+        case.to_str().unwrap(),
+        "--until",
+        "0.3",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "a c0 of 1.5 m/s ran to the end: {}",
+        text(&out.stdout)
+    );
+    assert!(stderr.contains("blew up"), "{stderr}");
+    let csv = fs::read_to_string(out_dir.join("gauges.csv")).unwrap();
+    assert!(
+        csv.lines().count() >= 3,
+        "rows before the failure were lost: {csv}"
+    );
+    assert!(out_dir.join("particles_0001.vtk").exists());
+    assert!(out_dir.join("particles_failed.vtk").exists());
+}
+
+/// Splits the next text line (without its newline) off `bytes`.
+fn take_line(bytes: &mut &[u8]) -> String {
+    let end = bytes.iter().position(|b| *b == b'\n').expect("a newline");
+    let line = String::from_utf8_lossy(&bytes[..end]).into_owned();
+    *bytes = &bytes[end + 1..];
+    line
+}
+
+/// The text lines of a legacy binary VTK file, and the first binary block's size.
+fn check_vtk_header(bytes: &[u8], n: usize) {
+    let mut rest = bytes;
+    assert_eq!(take_line(&mut rest), "# vtk DataFile Version 3.0");
+    assert!(take_line(&mut rest).contains("dambreak_water"));
+    assert_eq!(take_line(&mut rest), "BINARY");
+    assert_eq!(take_line(&mut rest), "DATASET POLYDATA");
+    assert_eq!(take_line(&mut rest), format!("POINTS {n} float"));
+    // n big-endian xyz triples, then the cell list on the next line.
+    rest = &rest[12 * n..];
+    assert_eq!(take_line(&mut rest), "");
+    assert_eq!(take_line(&mut rest), format!("VERTICES {n} {}", 2 * n));
+    assert_eq!(i32::from_be_bytes(rest[..4].try_into().unwrap()), 1);
+}
