@@ -14,9 +14,9 @@ use std::time::Instant;
 const DSPH_VERLET: f64 = 1.77e6;
 const DSPH_SYMPLECTIC: f64 = 0.95e6;
 
-/// Steps the solver records into the first submission of every `advance_to`, even when fewer
-/// are needed (a finished chunk's extra steps still cost a sort and the force passes).
-const MIN_CHUNK_STEPS: f64 = 8.0;
+/// Steps in the shortest stretch timed: a stretch of a few steps measures the submission and
+/// readback around it more than the steps themselves.
+const MIN_STRETCH_STEPS: f64 = 8.0;
 
 /// Spacing of the synthetic cases, m: the tank grows with the particle count, not the resolution.
 const BENCH_DP_M: f64 = 0.01;
@@ -68,28 +68,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
          the numerics of {}",
         reference.name
     );
-    let mut table = Table::new([
-        "particles",
-        "fluid",
-        "steps",
-        "wall s",
-        "steps/s",
-        "particle-steps/s",
-        "adapter",
-    ]);
+    let mut table = throughput_table();
     let mut errors = Vec::new();
     for &n in &args.ladder {
         let result = dam_break_case(n).and_then(|case| measure(&gpu, &case, args.steps_seconds));
         match result {
-            Ok(m) => table.row([
-                m.particles.to_string(),
-                m.fluid.to_string(),
-                m.steps.to_string(),
-                format!("{:.2}", m.wall_s),
-                sig(m.steps_per_s()),
-                sci(m.particle_steps_per_s()),
-                gpu.adapter.name.clone(),
-            ]),
+            Ok(m) => throughput_row(&mut table, &m, &gpu.adapter.name),
             Err(e) => {
                 failures += 1;
                 table.row([format!("~{n}"), "failed".to_string()]);
@@ -121,24 +105,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 }
 
 fn print_reference(m: &Measurement, case: &Case, adapter: &str) {
-    let mut table = Table::new([
-        "particles",
-        "fluid",
-        "steps",
-        "wall s",
-        "steps/s",
-        "particle-steps/s",
-        "adapter",
-    ]);
-    table.row([
-        m.particles.to_string(),
-        m.fluid.to_string(),
-        m.steps.to_string(),
-        format!("{:.2}", m.wall_s),
-        sig(m.steps_per_s()),
-        sci(m.particle_steps_per_s()),
-        adapter.to_string(),
-    ]);
+    let mut table = throughput_table();
+    throughput_row(&mut table, m, adapter);
     print!("{table}");
     let rate = m.particle_steps_per_s();
     println!("against DualSPHysics 5.4 on the CPU (2 OpenMP threads), same case:");
@@ -163,6 +131,31 @@ fn print_reference(m: &Measurement, case: &Case, adapter: &str) {
         m.start_s + m.sim_s,
         case.time.end_s
     );
+}
+
+fn throughput_table() -> Table {
+    Table::new([
+        "particles",
+        "fluid",
+        "steps",
+        "wall s",
+        "steps/s",
+        "particle-steps/s",
+        "adapter",
+    ])
+}
+
+/// One row of a throughput table.
+fn throughput_row(table: &mut Table, m: &Measurement, adapter: &str) {
+    table.row([
+        m.particles.to_string(),
+        m.fluid.to_string(),
+        m.steps.to_string(),
+        format!("{:.2}", m.wall_s),
+        sig(m.steps_per_s()),
+        sci(m.particle_steps_per_s()),
+        adapter.to_string(),
+    ]);
 }
 
 /// A 2-D dam break with about `fluid` fluid particles: a column a wide and 2a high against the
@@ -211,9 +204,7 @@ fn measure(gpu: &Arc<GpuContext>, case: &Case, wall_target_s: f64) -> Result<Mea
     sim.advance_to(4.0 * dt_guess)
         .with_context(|| format!("{name}: warm-up failed"))?;
 
-    // Every `advance_to` costs at least MIN_CHUNK_STEPS steps of GPU time (the solver's first
-    // submission), used or not, so no stretch timed here is shorter than that.
-    let min_stretch_s = |sim: &Simulation| MIN_CHUNK_STEPS * sim.last_dt_s().max(dt_guess);
+    let min_stretch_s = |sim: &Simulation| MIN_STRETCH_STEPS * sim.last_dt_s().max(dt_guess);
 
     // Estimate wall s per simulated s from ever longer stretches until one is long enough
     // to trust (a tenth of the target, or half a second on a slow adapter).
