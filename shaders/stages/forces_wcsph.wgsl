@@ -5,8 +5,8 @@
 // Also the per-particle stable step of the variable time step, min-reduced into `state`.
 // Reference: solver/src/physics/interaction.rs.
 
-@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> vel_rho: array<vec4<f32>>;
+@group(0) @binding(1) var positions: texture_2d<f32>;
+@group(0) @binding(2) var vel_rho: texture_2d<f32>;
 @group(0) @binding(3) var<storage, read> cell_starts: array<u32>;
 @group(0) @binding(4) var<storage, read_write> forces: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> state: StepState;
@@ -23,8 +23,8 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.n_particles || idle || atomicLoad(&state.status) != 0u) {
         return;
     }
-    let pos_i = positions[i];
-    let vr_i = vel_rho[i];
+    let pos_i = textureLoad(positions, texel(i), 0);
+    let vr_i = textureLoad(vel_rho, texel(i), 0);
     let phase_i = bitcast<u32>(pos_i.w);
     let mobile_i = params.phases[phase_i].mobile > 0.5;
     let rho_i = vr_i.w;
@@ -45,7 +45,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
         for (var j = range.x; j < range.y; j++) {
-            let pos_j = positions[j];
+            let pos_j = textureLoad(positions, texel(j), 0);
             let dx = pos_i.xyz - pos_j.xyz;
             let r2 = dot(dx, dx);
             if (r2 >= four_h2 || r2 < r2_min) {
@@ -56,7 +56,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (!mobile_i && !mobile_j) {
                 continue;
             }
-            let vr_j = vel_rho[j];
+            let vr_j = textureLoad(vel_rho, texel(j), 0);
             let dv = vr_i.xyz - vr_j.xyz;
             let f = kernel_grad_factor(sqrt(r2));
             let m_j = params.phases[phase_j].mass;

@@ -1,8 +1,8 @@
 // Kernel sums at probe points: the "fullness" sum_j V_j W (free-surface gauges, as DualSPHysics'
 // SWL gauge) and sum_j V_j p_j W (Shepard-corrected pressure). Reference: physics/probe.rs.
 
-@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> vel_rho: array<vec4<f32>>;
+@group(0) @binding(1) var positions: texture_2d<f32>;
+@group(0) @binding(2) var vel_rho: texture_2d<f32>;
 @group(0) @binding(3) var<storage, read> cell_starts: array<u32>;
 @group(0) @binding(4) var<storage, read> probe_points: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> probe_sums: array<vec2<f32>>;
@@ -21,14 +21,14 @@ fn probe_interpolate(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
         for (var j = range.x; j < range.y; j++) {
-            let pos_j = positions[j];
+            let pos_j = textureLoad(positions, texel(j), 0);
             let dx = x - pos_j.xyz;
             let r2 = dot(dx, dx);
             let phase_j = bitcast<u32>(pos_j.w);
             if (r2 >= four_h2 || params.phases[phase_j].mobile < 0.5) {
                 continue;
             }
-            let rho_j = vel_rho[j].w;
+            let rho_j = textureLoad(vel_rho, texel(j), 0).w;
             let vw = params.phases[phase_j].mass / rho_j * kernel_w(sqrt(r2));
             fullness += vw;
             pressure += vw * tait_pressure(rho_j, phase_j);

@@ -3,7 +3,7 @@
 //! `SphPipeline` holds the compiled stages and no particle state; `GpuBuffers` holds the
 //! state; `Bindings` ties the two together once, at setup. A step never reads back.
 
-use crate::gpu::buffers::storage;
+use crate::gpu::buffers::{particle_texture, storage};
 use crate::gpu::params::{ScanInfo, StepState};
 use crate::gpu::stage::{Stage, groups};
 use crate::gpu::{GpuContext, GpuError};
@@ -23,7 +23,8 @@ pub struct SphPipeline {
     forces_predict: Stage,
     forces_correct: Stage,
     dt_update: Stage,
-    integrate: Stage,
+    symplectic_predictor: Stage,
+    symplectic_corrector: Stage,
     probe_interpolate: Stage,
     observe_reduce: Stage,
 }
@@ -55,21 +56,27 @@ impl SphPipeline {
                 &[stencil[0], stencil[1], ("REDUCE_DT", 0.0)],
             ),
             dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
-            integrate: Stage::new(d, &stages::INTEGRATE_SYMPLECTIC, &[]),
+            symplectic_predictor: Stage::new(d, &stages::SYMPLECTIC_PREDICTOR, &[]),
+            symplectic_corrector: Stage::new(d, &stages::SYMPLECTIC_CORRECTOR, &[]),
             probe_interpolate: Stage::new(d, &stages::PROBE_INTERPOLATE, &stencil),
             observe_reduce: Stage::new(d, &stages::OBSERVE_REDUCE, &[]),
         }
     }
 }
 
+/// Rows of the particle textures are 2^TEXEL_ROW_SHIFT texels wide; mirrors the WGSL constant
+/// of the same name in `shaders/common/particle_texture.wgsl` (checked by `shaders_validate`).
+pub const TEXEL_ROW_SHIFT: u32 = 11;
+
 /// Particle state and scratch, all resident on the GPU. `a` is the state between steps,
-/// `b` its copy in cell order at the start of a step, `c` the half-step state.
+/// `b` its copy in cell order at the start of a step, `c` the half-step state; `b` and `c`
+/// are textures because neighbour loops read them (see `particle_texture.wgsl`).
 pub struct GpuBuffers {
     pub params: wgpu::Buffer,
     pub a: StateBuffers,
-    pub b: StateBuffers,
-    pub c_positions: wgpu::Buffer,
-    pub c_vel_rho: wgpu::Buffer,
+    pub b: StateTextures,
+    pub b_ids: wgpu::Buffer,
+    pub c: StateTextures,
     pub forces: wgpu::Buffer,
     pub cell_of: wgpu::Buffer,
     pub cell_starts: wgpu::Buffer,
@@ -89,6 +96,20 @@ pub struct StateBuffers {
     pub ids: wgpu::Buffer,
 }
 
+pub struct StateTextures {
+    pub positions: wgpu::TextureView,
+    pub vel_rho: wgpu::TextureView,
+}
+
+impl StateTextures {
+    fn new(gpu: &GpuContext, label: &str, n: u64) -> StateTextures {
+        StateTextures {
+            positions: particle_texture(gpu, &format!("{label}.positions"), n, TEXEL_ROW_SHIFT),
+            vel_rho: particle_texture(gpu, &format!("{label}.vel_rho"), n, TEXEL_ROW_SHIFT),
+        }
+    }
+}
+
 /// Bytes per particle and per cell of `GpuBuffers`, for the up-front size check.
 pub const VEC4_BYTES: u64 = 16;
 
@@ -97,6 +118,16 @@ impl GpuBuffers {
     pub fn check_limits(gpu: &GpuContext, n_particles: u64, n_cells: u64) -> Result<(), GpuError> {
         gpu.check_storage_size("positions", n_particles * VEC4_BYTES)?;
         gpu.check_storage_size("cell_starts", (n_cells + 1) * 4)?;
+        let rows = n_particles.div_ceil(1 << TEXEL_ROW_SHIFT);
+        let max_rows = u64::from(gpu.limits.max_texture_dimension_2d);
+        if rows > max_rows {
+            return Err(GpuError::TooLarge {
+                buffer: "particle textures".to_string(),
+                needed_mib: (n_particles * VEC4_BYTES) as f64 / 1048576.0,
+                limit_mib: ((max_rows << TEXEL_ROW_SHIFT) * VEC4_BYTES) as f64 / 1048576.0,
+                adapter: gpu.adapter.name.clone(),
+            });
+        }
         let max_groups = u64::from(gpu.limits.max_compute_workgroups_per_dimension);
         if n_particles.div_ceil(64) > max_groups || (n_cells + 1).div_ceil(128) > max_groups {
             return Err(GpuError::TooLarge {
@@ -117,11 +148,7 @@ impl GpuBuffers {
         n_probes: u32,
     ) -> GpuBuffers {
         let n = a.positions.size() / VEC4_BYTES;
-        let b = StateBuffers {
-            positions: storage(gpu, "b.positions", n * VEC4_BYTES),
-            vel_rho: storage(gpu, "b.vel_rho", n * VEC4_BYTES),
-            ids: storage(gpu, "b.ids", n * 4),
-        };
+        let b = StateTextures::new(gpu, "b", n);
         let mut scan_levels = Vec::new();
         let mut len = n_cells + 1;
         loop {
@@ -147,8 +174,8 @@ impl GpuBuffers {
         GpuBuffers {
             params,
             b,
-            c_positions: storage(gpu, "c.positions", n * VEC4_BYTES),
-            c_vel_rho: storage(gpu, "c.vel_rho", n * VEC4_BYTES),
+            b_ids: storage(gpu, "b.ids", n * 4),
+            c: StateTextures::new(gpu, "c", n),
             forces: storage(gpu, "forces", n * VEC4_BYTES),
             cell_of: storage(gpu, "cell_of", n * 4),
             cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),
@@ -174,7 +201,8 @@ pub struct Bindings {
     forces_predict: wgpu::BindGroup,
     forces_correct: wgpu::BindGroup,
     dt_update: wgpu::BindGroup,
-    integrate: wgpu::BindGroup,
+    symplectic_predictor: wgpu::BindGroup,
+    symplectic_corrector: wgpu::BindGroup,
     probe_interpolate: wgpu::BindGroup,
     observe_reduce: wgpu::BindGroup,
     n_particles: u32,
@@ -229,7 +257,7 @@ impl SphPipeline {
                     &g.a.ids,
                     &g.b.positions,
                     &g.b.vel_rho,
-                    &g.b.ids,
+                    &g.b_ids,
                 ],
             ),
             forces_predict: self.forces_predict.bind(
@@ -247,15 +275,15 @@ impl SphPipeline {
                 d,
                 &[
                     &g.params,
-                    &g.c_positions,
-                    &g.c_vel_rho,
+                    &g.c.positions,
+                    &g.c.vel_rho,
                     &g.cell_starts,
                     &g.forces,
                     &g.state,
                 ],
             ),
             dt_update: self.dt_update.bind(d, &[&g.params, &g.state]),
-            integrate: self.integrate.bind(
+            symplectic_predictor: self.symplectic_predictor.bind(
                 d,
                 &[
                     &g.params,
@@ -263,9 +291,20 @@ impl SphPipeline {
                     &g.forces,
                     &g.b.positions,
                     &g.b.vel_rho,
-                    &g.b.ids,
-                    &g.c_positions,
-                    &g.c_vel_rho,
+                    &g.c.positions,
+                    &g.c.vel_rho,
+                ],
+            ),
+            symplectic_corrector: self.symplectic_corrector.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.forces,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.c.vel_rho,
                     &g.a.positions,
                     &g.a.vel_rho,
                     &g.a.ids,
@@ -323,10 +362,12 @@ impl SphPipeline {
         self.forces_predict
             .record(pass, 0, &b.forces_predict, groups(n, 64));
         self.dt_update.record(pass, 0, &b.dt_update, 1);
-        self.integrate.record(pass, 0, &b.integrate, groups(n, 128));
+        self.symplectic_predictor
+            .record(pass, 0, &b.symplectic_predictor, groups(n, 128));
         self.forces_correct
             .record(pass, 0, &b.forces_correct, groups(n, 64));
-        self.integrate.record(pass, 1, &b.integrate, groups(n, 128));
+        self.symplectic_corrector
+            .record(pass, 0, &b.symplectic_corrector, groups(n, 128));
     }
 
     /// Forces at the current state only (no integration): for tests against the CPU oracle.

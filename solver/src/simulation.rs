@@ -334,7 +334,7 @@ impl Simulation {
             &self.gpu,
             &[
                 (&self.buffers.forces, n * 16),
-                (&self.buffers.b.ids, n * 4),
+                (&self.buffers.b_ids, n * 4),
                 (&self.buffers.state, std::mem::size_of::<StepState>() as u64),
             ],
         )?;
@@ -364,7 +364,7 @@ impl Simulation {
             &self.gpu,
             &[
                 (&self.buffers.cell_starts, cells * 4),
-                (&self.buffers.b.ids, n * 4),
+                (&self.buffers.b_ids, n * 4),
             ],
         )?;
         Ok((cast_vec(&raw[0]), cast_vec(&raw[1])))

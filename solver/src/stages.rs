@@ -16,9 +16,15 @@ const WITH_NEIGHBOURS: &[&str] = &[
     "common/eos.wgsl",
     "common/grid.wgsl",
     "common/neighbours.wgsl",
+    "common/particle_texture.wgsl",
     "common/step_state.wgsl",
 ];
 const WITH_STATE: &[&str] = &["common/params.wgsl", "common/step_state.wgsl"];
+const INTEGRATE: &[&str] = &[
+    "common/params.wgsl",
+    "common/particle_texture.wgsl",
+    "common/step_state.wgsl",
+];
 
 pub const GRID_CLEAR: StageSpec = StageSpec {
     name: "grid_clear",
@@ -94,15 +100,15 @@ pub const CELL_SORT: StageSpec = StageSpec {
 pub const REORDER: StageSpec = StageSpec {
     name: "reorder",
     shader: "stages/reorder.wgsl",
-    imports: &["common/params.wgsl"],
+    imports: &["common/params.wgsl", "common/particle_texture.wgsl"],
     bindings: &[
         ("params", 0, Uniform),
         ("sorted_index", 1, Read),
         ("positions", 2, Read),
         ("vel_rho", 3, Read),
         ("ids", 4, Read),
-        ("sorted_positions", 5, ReadWrite),
-        ("sorted_vel_rho", 6, ReadWrite),
+        ("sorted_positions", 5, TextureWrite),
+        ("sorted_vel_rho", 6, TextureWrite),
         ("sorted_ids", 7, ReadWrite),
     ],
     entry_points: &["reorder"],
@@ -115,8 +121,8 @@ pub const FORCES_WCSPH: StageSpec = StageSpec {
     imports: WITH_NEIGHBOURS,
     bindings: &[
         ("params", 0, Uniform),
-        ("positions", 1, Read),
-        ("vel_rho", 2, Read),
+        ("positions", 1, Texture),
+        ("vel_rho", 2, Texture),
         ("cell_starts", 3, Read),
         ("forces", 4, ReadWrite),
         ("state", 5, ReadWrite),
@@ -134,24 +140,40 @@ pub const DT_UPDATE: StageSpec = StageSpec {
     workgroup: 1,
 };
 
-pub const INTEGRATE_SYMPLECTIC: StageSpec = StageSpec {
-    name: "integrate_symplectic",
-    shader: "stages/integrate_symplectic.wgsl",
-    imports: WITH_STATE,
+pub const SYMPLECTIC_PREDICTOR: StageSpec = StageSpec {
+    name: "symplectic_predictor",
+    shader: "stages/symplectic_predictor.wgsl",
+    imports: INTEGRATE,
     bindings: &[
         ("params", 0, Uniform),
         ("state", 1, ReadWrite),
         ("forces", 2, Read),
-        ("positions_n", 3, Read),
-        ("vel_rho_n", 4, Read),
-        ("ids_n", 5, Read),
-        ("positions_half", 6, ReadWrite),
-        ("vel_rho_half", 7, ReadWrite),
-        ("positions_out", 8, ReadWrite),
-        ("vel_rho_out", 9, ReadWrite),
-        ("ids_out", 10, ReadWrite),
+        ("positions_n", 3, Texture),
+        ("vel_rho_n", 4, Texture),
+        ("positions_half", 5, TextureWrite),
+        ("vel_rho_half", 6, TextureWrite),
     ],
-    entry_points: &["predictor", "corrector"],
+    entry_points: &["symplectic_predictor"],
+    workgroup: 128,
+};
+
+pub const SYMPLECTIC_CORRECTOR: StageSpec = StageSpec {
+    name: "symplectic_corrector",
+    shader: "stages/symplectic_corrector.wgsl",
+    imports: INTEGRATE,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("state", 1, ReadWrite),
+        ("forces", 2, Read),
+        ("positions_n", 3, Texture),
+        ("vel_rho_n", 4, Texture),
+        ("ids_n", 5, Read),
+        ("vel_rho_half", 6, Texture),
+        ("positions_out", 7, ReadWrite),
+        ("vel_rho_out", 8, ReadWrite),
+        ("ids_out", 9, ReadWrite),
+    ],
+    entry_points: &["symplectic_corrector"],
     workgroup: 128,
 };
 
@@ -161,8 +183,8 @@ pub const PROBE_INTERPOLATE: StageSpec = StageSpec {
     imports: WITH_NEIGHBOURS,
     bindings: &[
         ("params", 0, Uniform),
-        ("positions", 1, Read),
-        ("vel_rho", 2, Read),
+        ("positions", 1, Texture),
+        ("vel_rho", 2, Texture),
         ("cell_starts", 3, Read),
         ("probe_points", 4, Read),
         ("probe_sums", 5, ReadWrite),
@@ -195,7 +217,8 @@ pub const ALL: &[&StageSpec] = &[
     &REORDER,
     &FORCES_WCSPH,
     &DT_UPDATE,
-    &INTEGRATE_SYMPLECTIC,
+    &SYMPLECTIC_PREDICTOR,
+    &SYMPLECTIC_CORRECTOR,
     &PROBE_INTERPOLATE,
     &OBSERVE_REDUCE,
 ];

@@ -41,6 +41,27 @@ fn declared_bindings_match_the_wgsl_globals() {
                         Access::ReadWrite
                     }
                     naga::AddressSpace::Storage { .. } => Access::Read,
+                    naga::AddressSpace::Handle => match &module.types[g.ty].inner {
+                        naga::TypeInner::Image {
+                            class:
+                                naga::ImageClass::Sampled {
+                                    kind: naga::ScalarKind::Float,
+                                    multi: false,
+                                },
+                            dim: naga::ImageDimension::D2,
+                            arrayed: false,
+                        } => Access::Texture,
+                        naga::TypeInner::Image {
+                            class:
+                                naga::ImageClass::Storage {
+                                    format: naga::StorageFormat::Rgba32Float,
+                                    access,
+                                },
+                            dim: naga::ImageDimension::D2,
+                            arrayed: false,
+                        } if *access == naga::StorageAccess::STORE => Access::TextureWrite,
+                        other => panic!("{}: unexpected handle type {other:?}", spec.name),
+                    },
                     other => panic!("{}: unexpected address space {other:?}", spec.name),
                 };
                 Some((g.name.clone().unwrap_or_default(), b.binding, access))
@@ -80,6 +101,26 @@ fn entry_points_and_workgroup_sizes_match() {
             "a single-entry stage is named after its entry point: {}",
             spec.name
         );
+    }
+}
+
+#[test]
+fn texel_row_shift_is_the_same_in_rust_and_wgsl() {
+    let forces = ALL
+        .iter()
+        .find(|s| s.name == "forces_wcsph")
+        .expect("forces stage");
+    let module = parse("forces_wcsph", &forces.source());
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some("TEXEL_ROW_SHIFT"))
+        .expect("WGSL constant TEXEL_ROW_SHIFT");
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => {
+            assert_eq!(v, flume_solver::pipeline::TEXEL_ROW_SHIFT)
+        }
+        ref other => panic!("TEXEL_ROW_SHIFT is not a u32 literal: {other:?}"),
     }
 }
 

@@ -42,6 +42,34 @@ fn init(gpu: &GpuContext, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) 
         })
 }
 
+/// An rgba32float texture of one texel per particle, rows of `1 << row_shift` texels, that
+/// stages write as storage and neighbour loops read with `textureLoad`.
+pub fn particle_texture(
+    gpu: &GpuContext,
+    label: &str,
+    n: u64,
+    row_shift: u32,
+) -> wgpu::TextureView {
+    let width = 1u32 << row_shift;
+    let height = (n.div_ceil(u64::from(width)) as u32).max(1);
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::STORAGE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
 /// Copies `bytes` from the start of each buffer and waits for the result; one submission.
 pub fn read_buffers(
     gpu: &GpuContext,

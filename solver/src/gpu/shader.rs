@@ -4,76 +4,33 @@
 //! wrapper's `IMPORTS`; composition prepends them in the order given. Nothing is substituted
 //! inside any source, so each composed module is the plain concatenation of files on disk.
 
+macro_rules! embed {
+    ($($path:literal),* $(,)?) => {
+        &[$(($path, include_str!(concat!("../../../shaders/", $path)))),*]
+    };
+}
+
 /// Every WGSL file of the solver, by its path under `shaders/`.
-pub const SOURCES: &[(&str, &str)] = &[
-    (
-        "common/params.wgsl",
-        include_str!("../../../shaders/common/params.wgsl"),
-    ),
-    (
-        "common/kernel.wgsl",
-        include_str!("../../../shaders/common/kernel.wgsl"),
-    ),
-    (
-        "common/eos.wgsl",
-        include_str!("../../../shaders/common/eos.wgsl"),
-    ),
-    (
-        "common/grid.wgsl",
-        include_str!("../../../shaders/common/grid.wgsl"),
-    ),
-    (
-        "common/neighbours.wgsl",
-        include_str!("../../../shaders/common/neighbours.wgsl"),
-    ),
-    (
-        "common/step_state.wgsl",
-        include_str!("../../../shaders/common/step_state.wgsl"),
-    ),
-    (
-        "stages/grid_clear.wgsl",
-        include_str!("../../../shaders/stages/grid_clear.wgsl"),
-    ),
-    (
-        "stages/grid_count.wgsl",
-        include_str!("../../../shaders/stages/grid_count.wgsl"),
-    ),
-    (
-        "stages/prefix_sum.wgsl",
-        include_str!("../../../shaders/stages/prefix_sum.wgsl"),
-    ),
-    (
-        "stages/grid_scatter.wgsl",
-        include_str!("../../../shaders/stages/grid_scatter.wgsl"),
-    ),
-    (
-        "stages/cell_sort.wgsl",
-        include_str!("../../../shaders/stages/cell_sort.wgsl"),
-    ),
-    (
-        "stages/reorder.wgsl",
-        include_str!("../../../shaders/stages/reorder.wgsl"),
-    ),
-    (
-        "stages/forces_wcsph.wgsl",
-        include_str!("../../../shaders/stages/forces_wcsph.wgsl"),
-    ),
-    (
-        "stages/dt_update.wgsl",
-        include_str!("../../../shaders/stages/dt_update.wgsl"),
-    ),
-    (
-        "stages/integrate_symplectic.wgsl",
-        include_str!("../../../shaders/stages/integrate_symplectic.wgsl"),
-    ),
-    (
-        "stages/probe_interpolate.wgsl",
-        include_str!("../../../shaders/stages/probe_interpolate.wgsl"),
-    ),
-    (
-        "stages/observe_reduce.wgsl",
-        include_str!("../../../shaders/stages/observe_reduce.wgsl"),
-    ),
+pub const SOURCES: &[(&str, &str)] = embed![
+    "common/params.wgsl",
+    "common/kernel.wgsl",
+    "common/eos.wgsl",
+    "common/grid.wgsl",
+    "common/neighbours.wgsl",
+    "common/particle_texture.wgsl",
+    "common/step_state.wgsl",
+    "stages/grid_clear.wgsl",
+    "stages/grid_count.wgsl",
+    "stages/prefix_sum.wgsl",
+    "stages/grid_scatter.wgsl",
+    "stages/cell_sort.wgsl",
+    "stages/reorder.wgsl",
+    "stages/forces_wcsph.wgsl",
+    "stages/dt_update.wgsl",
+    "stages/symplectic_predictor.wgsl",
+    "stages/symplectic_corrector.wgsl",
+    "stages/probe_interpolate.wgsl",
+    "stages/observe_reduce.wgsl",
 ];
 
 pub fn source(path: &str) -> &'static str {

@@ -8,6 +8,27 @@ pub enum Access {
     Uniform,
     Read,
     ReadWrite,
+    /// A `texture_2d<f32>` of rgba32float particle data, read with `textureLoad`.
+    Texture,
+    /// A `texture_storage_2d<rgba32float, write>`.
+    TextureWrite,
+}
+
+/// Something a bind group entry can hold: a buffer or a texture view.
+pub trait AsBinding {
+    fn resource(&self) -> wgpu::BindingResource<'_>;
+}
+
+impl AsBinding for wgpu::Buffer {
+    fn resource(&self) -> wgpu::BindingResource<'_> {
+        self.as_entire_binding()
+    }
+}
+
+impl AsBinding for wgpu::TextureView {
+    fn resource(&self) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::TextureView(self)
+    }
 }
 
 /// One binding of a stage: the WGSL global's name, its index in group 0 and its access.
@@ -53,15 +74,7 @@ impl Stage {
             .map(|(_, index, access)| wgpu::BindGroupLayoutEntry {
                 binding: *index,
                 visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: match access {
-                        Access::Uniform => wgpu::BufferBindingType::Uniform,
-                        Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
-                        Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
-                    },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
+                ty: binding_type(*access),
                 count: None,
             })
             .collect();
@@ -105,7 +118,7 @@ impl Stage {
     }
 
     /// Builds a bind group; `buffers` are given in the order of the stage's declared bindings.
-    pub fn bind(&self, device: &wgpu::Device, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+    pub fn bind(&self, device: &wgpu::Device, buffers: &[&dyn AsBinding]) -> wgpu::BindGroup {
         assert_eq!(
             buffers.len(),
             self.spec.bindings.len(),
@@ -120,7 +133,7 @@ impl Stage {
             .zip(buffers)
             .map(|((_, index, _), buffer)| wgpu::BindGroupEntry {
                 binding: *index,
-                resource: buffer.as_entire_binding(),
+                resource: buffer.resource(),
             })
             .collect();
         device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -144,6 +157,29 @@ impl Stage {
         pass.set_pipeline(&self.pipelines[entry]);
         pass.set_bind_group(0, bind, &[]);
         pass.dispatch_workgroups(groups, 1, 1);
+    }
+}
+
+fn binding_type(access: Access) -> wgpu::BindingType {
+    let buffer = |ty| wgpu::BindingType::Buffer {
+        ty,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    match access {
+        Access::Uniform => buffer(wgpu::BufferBindingType::Uniform),
+        Access::Read => buffer(wgpu::BufferBindingType::Storage { read_only: true }),
+        Access::ReadWrite => buffer(wgpu::BufferBindingType::Storage { read_only: false }),
+        Access::Texture => wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        Access::TextureWrite => wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: wgpu::TextureFormat::Rgba32Float,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
     }
 }
 

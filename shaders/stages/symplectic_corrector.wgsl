@@ -1,0 +1,52 @@
+// Symplectic position-Verlet integration as in DualSPHysics, second half step:
+// v(n+1) = v(n) + dt a(n+1/2), x(n+1) = x(n) + dt (v(n) + v(n+1)) / 2,
+// rho(n+1) = rho(n) (2 - eps) / (2 + eps) with eps = -dt drho(n+1/2) / rho(n+1/2).
+// Writes the new state, in cell order, back to the state buffers, and raises health flags.
+// Reference: solver/src/physics/integrate.rs.
+
+@group(0) @binding(1) var<storage, read_write> state: StepState;
+@group(0) @binding(2) var<storage, read> forces: array<vec4<f32>>;
+@group(0) @binding(3) var positions_n: texture_2d<f32>;
+@group(0) @binding(4) var vel_rho_n: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> ids_n: array<u32>;
+@group(0) @binding(6) var vel_rho_half: texture_2d<f32>;
+@group(0) @binding(7) var<storage, read_write> positions_out: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> vel_rho_out: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
+
+@compute @workgroup_size(128)
+fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.n_particles) {
+        return;
+    }
+    let dt = state.dt;
+    let p = textureLoad(positions_n, texel(i), 0);
+    let vr = textureLoad(vel_rho_n, texel(i), 0);
+    let f = forces[i];
+    let phase = bitcast<u32>(p.w);
+    let ph = params.phases[phase];
+    let eps = -(f.w / textureLoad(vel_rho_half, texel(i), 0).w) * dt;
+    let rho = vr.w * (2.0 - eps) / (2.0 + eps);
+    ids_out[i] = ids_n[i];
+    if (ph.mobile > 0.5) {
+        let v = vr.xyz + dt * f.xyz;
+        let x = p.xyz + dt * 0.5 * (vr.xyz + v);
+        positions_out[i] = vec4<f32>(x, p.w);
+        vel_rho_out[i] = vec4<f32>(v, rho);
+        var flags = 0u;
+        let s = dot(x, x) + dot(v, v) + rho;
+        // NaN compares false with everything; infinities exceed the largest finite f32.
+        if (!(abs(s) <= 3.0e38)) {
+            flags |= STATUS_NON_FINITE;
+        } else if (abs(rho / ph.rho0 - 1.0) > params.rho_ratio_max) {
+            flags |= STATUS_DENSITY_RUNAWAY;
+        }
+        if (flags != 0u) {
+            atomicOr(&state.status, flags);
+        }
+    } else {
+        positions_out[i] = p;
+        vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));
+    }
+}
