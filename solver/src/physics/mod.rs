@@ -17,6 +17,7 @@ pub mod integrate;
 pub mod interaction;
 pub mod kernel;
 pub mod probe;
+pub mod sediment;
 pub mod timestep;
 
 /// One material. Particles point into the phase table through the bits of `pos[i][3]`.
