@@ -217,6 +217,10 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
         "max density error".to_string(),
         format!("{:.3e}", last.max_density_error),
     ]);
+    t.row([
+        "blow-ups recovered".to_string(),
+        format!("{} (CFL now {})", last.recoveries, last.cfl),
+    ]);
     println!();
     print!("{t}");
 }

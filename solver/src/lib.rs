@@ -17,4 +17,4 @@ pub mod stages;
 pub use config::{Case, ConfigError};
 pub use gpu::{GpuContext, GpuError};
 pub use observe::Observations;
-pub use simulation::{Health, Simulation, SolverError};
+pub use simulation::{Health, Recovery, Simulation, SolverError};

@@ -37,6 +37,10 @@ pub struct Observations {
     /// Largest |rho / rho0 - 1| over fluid particles.
     pub max_density_error: f64,
     pub fluid_particles: u32,
+    /// Blow-ups recovered from since the start (see `Simulation::recoveries`).
+    pub recoveries: u32,
+    /// The CFL number in force.
+    pub cfl: f64,
 }
 
 /// The sample points of every gauge column and probe, in the order the GPU evaluates them.
@@ -127,6 +131,8 @@ impl ProbeLayout {
             max_speed_m_per_s: f64::from(f32::from_bits(ext.max_speed_bits)),
             max_density_error: f64::from(f32::from_bits(ext.max_rho_err_bits)),
             fluid_particles: ext.fluid_count,
+            recoveries: 0,
+            cfl: 0.0,
         }
     }
 }

@@ -76,6 +76,8 @@ pub struct GpuBuffers {
     pub a: StateBuffers,
     pub b: StateTextures,
     pub b_ids: wgpu::Buffer,
+    /// A copy of `a` taken at the start of each chunk, restored after a blow-up.
+    pub snapshot: StateBuffers,
     pub c: StateTextures,
     pub forces: wgpu::Buffer,
     pub cell_of: wgpu::Buffer,
@@ -175,6 +177,11 @@ impl GpuBuffers {
             params,
             b,
             b_ids: storage(gpu, "b.ids", n * 4),
+            snapshot: StateBuffers {
+                positions: storage(gpu, "snapshot.positions", n * VEC4_BYTES),
+                vel_rho: storage(gpu, "snapshot.vel_rho", n * VEC4_BYTES),
+                ids: storage(gpu, "snapshot.ids", n * 4),
+            },
             c: StateTextures::new(gpu, "c", n),
             forces: storage(gpu, "forces", n * VEC4_BYTES),
             cell_of: storage(gpu, "cell_of", n * 4),

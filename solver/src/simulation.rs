@@ -26,6 +26,8 @@ pub enum SolverError {
     },
     #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
     TimeGoesBack { target_s: f64, now_s: f64 },
+    #[error("parameter `{name}` refused: {reason}")]
+    InvalidParameter { name: &'static str, reason: String },
 }
 
 /// Health flags raised on the GPU by the step loop.
@@ -60,10 +62,28 @@ impl std::fmt::Display for Health {
     }
 }
 
+/// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
+/// the last try, before the blow-up is returned as an error.
+pub const MAX_RECOVERIES_PER_CHUNK: u32 = 4;
+/// Largest CFL number `set_cfl` accepts; above about 1 the scheme is unstable.
+pub const MAX_CFL: f64 = 5.0;
+
+/// A blow-up the solver recovered from by rolling back and shrinking the time step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recovery {
+    /// When it blew up, s, and what the GPU saw.
+    pub failed_at_s: f64,
+    pub health: Health,
+    /// The time it rolled back to, s, and the CFL number it retried with.
+    pub restored_to_s: f64,
+    pub cfl: f64,
+}
+
 /// Largest number of steps recorded into one submission.
 const MAX_STEPS_PER_SUBMIT: u32 = 400;
-/// |rho / rho0 - 1| above which a density is a runaway (weakly compressible: about 1 %).
-const RHO_RATIO_MAX: f32 = 0.5;
+/// |rho / rho0 - 1| above which a density is a runaway: ten times the 1 % that a weakly
+/// compressible flow shows with c0 >= 10 u_max (Eq. 5).
+const RHO_RATIO_MAX: f32 = 0.1;
 
 pub struct Simulation {
     gpu: Arc<GpuContext>,
@@ -78,6 +98,7 @@ pub struct Simulation {
     steps: u64,
     last_dt_s: f64,
     initial_particles: Particles,
+    recoveries: Vec<Recovery>,
 }
 
 /// Grid of cells of size 2h / CELL_DIVISIONS covering the tank, its walls and a margin above it.
@@ -168,6 +189,7 @@ impl Simulation {
             steps: 0,
             last_dt_s: 0.0,
             initial_particles: particles,
+            recoveries: Vec::new(),
         })
     }
 
@@ -202,7 +224,11 @@ impl Simulation {
     }
 
     /// Runs the GPU step loop until simulated time reaches `target_s` (exactly).
-    /// Steps are recorded many to a submission; the host reads back only between submissions.
+    ///
+    /// The state at the start is kept on the GPU; if the chunk blows up (NaN, runaway density,
+    /// collapsing step), the state is restored and the chunk retried with half the CFL number,
+    /// up to `MAX_RECOVERIES_PER_CHUNK` times, each logged and listed in `recoveries`. The
+    /// smaller CFL number stays in force afterwards. Only then is the blow-up an error.
     pub fn advance_to(&mut self, target_s: f64) -> Result<(), SolverError> {
         if target_s < self.time_s {
             return Err(SolverError::TimeGoesBack {
@@ -210,6 +236,80 @@ impl Simulation {
                 now_s: self.time_s,
             });
         }
+        let saved = (self.time_s, self.steps, self.last_dt_s);
+        self.copy_state(&self.buffers.a, &self.buffers.snapshot);
+        let mut tries = 0;
+        loop {
+            match self.run_chunk(target_s) {
+                Err(SolverError::BlowUp {
+                    time_s,
+                    step,
+                    health,
+                }) if tries < MAX_RECOVERIES_PER_CHUNK => {
+                    tries += 1;
+                    self.copy_state(&self.buffers.snapshot, &self.buffers.a);
+                    (self.time_s, self.steps, self.last_dt_s) = saved;
+                    self.params.cfl *= 0.5;
+                    self.gpu.queue.write_buffer(
+                        &self.buffers.params,
+                        0,
+                        bytemuck::bytes_of(&self.params),
+                    );
+                    log::warn!(
+                        "blow-up at t = {time_s:.6} s (step {step}): {health}; restored t = {:.6} s, retrying with CFL {}",
+                        self.time_s,
+                        self.params.cfl
+                    );
+                    self.recoveries.push(Recovery {
+                        failed_at_s: time_s,
+                        health,
+                        restored_to_s: self.time_s,
+                        cfl: f64::from(self.params.cfl),
+                    });
+                }
+                other => return other,
+            }
+        }
+    }
+
+    /// Every blow-up recovered from so far, oldest first.
+    pub fn recoveries(&self) -> &[Recovery] {
+        &self.recoveries
+    }
+
+    /// The CFL number in force (the case's, or less after a recovery, or as set).
+    pub fn cfl(&self) -> f64 {
+        f64::from(self.params.cfl)
+    }
+
+    /// Changes the CFL number for the following steps; refuses values outside (0, MAX_CFL].
+    pub fn set_cfl(&mut self, cfl: f64) -> Result<(), SolverError> {
+        if !(cfl.is_finite() && cfl > 0.0 && cfl <= MAX_CFL) {
+            return Err(SolverError::InvalidParameter {
+                name: "cfl",
+                reason: format!("must be in (0, {MAX_CFL}], got {cfl}"),
+            });
+        }
+        self.params.cfl = cfl as f32;
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        Ok(())
+    }
+
+    fn copy_state(&self, from: &StateBuffers, to: &StateBuffers) {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        for (src, dst) in [
+            (&from.positions, &to.positions),
+            (&from.vel_rho, &to.vel_rho),
+            (&from.ids, &to.ids),
+        ] {
+            encoder.copy_buffer_to_buffer(src, 0, dst, 0, src.size());
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+    }
+
+    fn run_chunk(&mut self, target_s: f64) -> Result<(), SolverError> {
         let chunk_start = self.time_s;
         let rel_target = (target_s - chunk_start) as f32;
         if rel_target <= 0.0 {
@@ -403,9 +503,12 @@ impl Simulation {
         )?;
         let sums: Vec<[f32; 2]> = cast_vec(&raw[0]);
         let ext: Extremes = bytemuck::pod_read_unaligned(&raw[1]);
-        Ok(self
-            .probes
-            .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext))
+        let mut obs =
+            self.probes
+                .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext);
+        obs.recoveries = self.recoveries.len() as u32;
+        obs.cfl = self.cfl();
+        Ok(obs)
     }
 }
 

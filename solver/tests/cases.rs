@@ -259,3 +259,73 @@ fn an_unknown_adapter_name_lists_the_available_ones() {
         "{err}"
     );
 }
+
+/// An absurd CFL number makes the dam break blow up; the solver must notice on the GPU, roll
+/// back to the chunk's start, halve the CFL number until the chunk passes, say so, and go on
+/// with a state that is whole (finite, in the tank, every particle present).
+#[test]
+fn a_blow_up_is_caught_rolled_back_and_retried_with_a_smaller_cfl() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("../launch_configs/dambreak_water.yaml");
+    c.numerics.dp_m = 0.005;
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    sim.advance_to(0.01).expect("runs at the case's CFL");
+    assert!(sim.recoveries().is_empty());
+    sim.set_cfl(5.0).expect("accepted for the test");
+    sim.advance_to(0.03).expect("recovers");
+    let rec = sim.recoveries();
+    assert!(!rec.is_empty(), "CFL 5 did not blow up");
+    for r in rec {
+        eprintln!("recovered: {r:?}");
+        assert_eq!(r.restored_to_s, 0.01);
+        assert!(!r.health.is_ok());
+        assert!(r.failed_at_s >= 0.01 && r.failed_at_s <= 0.03);
+    }
+    assert_eq!(
+        sim.cfl(),
+        5.0 * 0.5f64.powi(rec.len() as i32),
+        "halved once per recovery"
+    );
+    assert_eq!(sim.time_s(), 0.03);
+    let obs = sim.observe().expect("observes");
+    assert_eq!(obs.recoveries as usize, rec.len());
+    assert!(
+        obs.max_density_error < 0.05,
+        "density error {}",
+        obs.max_density_error
+    );
+    let p = sim.read_particles().expect("readback");
+    assert_in_tank(&c, &p);
+    assert_mass_conserved(&sim, &p);
+    assert!(
+        sim.set_cfl(-1.0).is_err() && sim.set_cfl(f64::NAN).is_err() && sim.set_cfl(50.0).is_err()
+    );
+}
+
+/// A case that no time step can save (a sound speed far below the flow's speed) fails with
+/// the blow-up error after the retries, instead of returning garbage.
+#[test]
+fn an_unrecoverable_blow_up_is_an_error_that_says_so() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("../launch_configs/dambreak_water.yaml");
+    c.numerics.dp_m = 0.005;
+    c.numerics.sound_speed = flume_solver::config::SoundSpeed {
+        c0_m_per_s: Some(0.2),
+        coefsound: None,
+    };
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    let err = sim.advance_to(0.05).expect_err("cannot survive");
+    let text = err.to_string();
+    eprintln!("{text}");
+    assert!(
+        matches!(err, flume_solver::SolverError::BlowUp { .. }),
+        "{text}"
+    );
+    assert!(text.contains("blew up"), "{text}");
+    assert_eq!(
+        sim.recoveries().len(),
+        flume_solver::simulation::MAX_RECOVERIES_PER_CHUNK as usize
+    );
+}

@@ -7,13 +7,15 @@ use flume_solver::Observations;
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
-const FIXED_COLUMNS: [&str; 6] = [
+const FIXED_COLUMNS: [&str; 8] = [
     "time_s",
     "step",
     "dt_s",
     "front_m",
     "max_speed_m_per_s",
     "max_density_error",
+    "cfl",
+    "recoveries",
 ];
 
 pub struct GaugeCsv<W: Write> {
@@ -44,13 +46,15 @@ impl<W: Write> GaugeCsv<W> {
         // it as f32 (shortest round-trip text) avoids digits that mean nothing.
         let _ = write!(
             line,
-            "{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{}",
             obs.time_s,
             obs.steps,
             obs.dt_s as f32,
             obs.front_m as f32,
             obs.max_speed_m_per_s as f32,
-            obs.max_density_error as f32
+            obs.max_density_error as f32,
+            obs.cfl as f32,
+            obs.recoveries
         );
         let levels = obs.gauges.iter().map(|g| g.level_m);
         let pressures = obs.probes.iter().map(|p| p.pressure_pa);
@@ -118,13 +122,15 @@ mod tests {
             max_speed_m_per_s: 0.5,
             max_density_error: 0.002,
             fluid_particles: 3200,
+            recoveries: 1,
+            cfl: 0.1,
         };
         csv.row(&obs).unwrap();
         let text = String::from_utf8(buf).unwrap();
         assert_eq!(
             text,
-            "time_s,step,dt_s,front_m,max_speed_m_per_s,max_density_error,near_wall_m,\"a,b_m\",toe_pa\n\
-             0.005,42,0.000125,0.1,0.5,0.002,0.19,,1900.5\n"
+            "time_s,step,dt_s,front_m,max_speed_m_per_s,max_density_error,cfl,recoveries,near_wall_m,\"a,b_m\",toe_pa\n\
+             0.005,42,0.000125,0.1,0.5,0.002,0.1,1,0.19,,1900.5\n"
         );
     }
 }
