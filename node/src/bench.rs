@@ -121,8 +121,9 @@ fn print_reference(m: &Measurement, case: &Case, adapter: &str) {
         rate / DSPH_SYMPLECTIC
     );
     println!(
-        "  This solver's step is symplectic (two force passes), so the symplectic ratio is the\n  \
-         like-for-like one; a Verlet step costs DualSPHysics one force pass, about half as much."
+        "  This run used the {:?} integrator: compare with the line of the same scheme (a\n  \
+         Verlet step takes one force pass, a symplectic step two).",
+        case.numerics.integrator
     );
     println!(
         "real-time factor: {} simulated s per wall s (t = {:.4} .. {:.4} s of the {} s case)",
@@ -185,6 +186,7 @@ numerics:
   sound_speed: {{ coefsound: 20.0 }}
   density_diffusion: {{ method: fourtakas2019, delta: 0.1 }}
   viscosity: {{ method: artificial, alpha: 0.02 }}
+  integrator: {{ method: verlet, euler_every_steps: 40 }}
 gravity_m_per_s2: [0.0, -9.81]
 time: {{ end_s: 10.0, output_interval_s: 0.01 }}
 "

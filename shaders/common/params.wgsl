@@ -28,6 +28,10 @@ struct SimParams {
     rho_ratio_max: f32,      // |rho / rho0 - 1| above this is a runaway density
     vertical_axis: u32,      // 1 in 2-D (y up), 2 in 3-D (z up)
     n_probes: u32,
+    euler_every: u32,        // Verlet: an Euler step every this many steps
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
     phases: array<Phase, 4>,
     tait_b: vec4<f32>,       // c0^2 rho0 / 7 per phase
 }

@@ -9,7 +9,7 @@ struct StepState {
     dt_min_bits: atomic<u32>,   // min over particles of the stable step, as f32 bits (> 0)
     status: atomic<u32>,        // health flags, see `Health` in solver/src/simulation.rs
     last_dt: f32,               // the last non-zero step, s
-    pad: u32,
+    step_base: u32,             // steps taken before this chunk, modulo the Verlet Euler period
 }
 
 const STATUS_NON_FINITE: u32 = 1u;

@@ -114,6 +114,21 @@ pub struct Numerics {
     pub sound_speed: SoundSpeed,
     pub density_diffusion: DensityDiffusion,
     pub viscosity: Viscosity,
+    /// Time integration; symplectic when omitted.
+    #[serde(default)]
+    pub integrator: Integrator,
+}
+
+/// Time integration scheme (both as in DualSPHysics).
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, rename_all = "snake_case", tag = "method")]
+pub enum Integrator {
+    /// Symplectic position Verlet: predictor and corrector, two force passes a step.
+    #[default]
+    Symplectic,
+    /// Verlet (Verlet 1967, DualSPHysics' default): one force pass a step, with an Euler step
+    /// every `euler_every_steps` steps to keep the leapfrog's two sequences together.
+    Verlet { euler_every_steps: u32 },
 }
 
 fn default_coefh() -> f64 {
@@ -415,6 +430,14 @@ impl Case {
             return err(
                 "numerics.viscosity.alpha",
                 format!("must be in 0..=10, got {alpha}"),
+            );
+        }
+        if let Integrator::Verlet { euler_every_steps } = n.integrator
+            && !(1..=1000).contains(&euler_every_steps)
+        {
+            return err(
+                "numerics.integrator.euler_every_steps",
+                format!("must be in 1..=1000, got {euler_every_steps}"),
             );
         }
         let t = &self.time;

@@ -25,12 +25,15 @@ pub struct SphPipeline {
     dt_update: Stage,
     symplectic_predictor: Stage,
     symplectic_corrector: Stage,
+    verlet_update: Stage,
+    /// Verlet (one force pass a step) rather than symplectic (two).
+    verlet: bool,
     probe_interpolate: Stage,
     observe_reduce: Stage,
 }
 
 impl SphPipeline {
-    pub fn new(gpu: &GpuContext, dim: u32) -> SphPipeline {
+    pub fn new(gpu: &GpuContext, dim: u32, verlet: bool) -> SphPipeline {
         let d = &gpu.device;
         let width = f64::from(2 * CELL_DIVISIONS + 1);
         let rows = if dim == 2 { width } else { width * width };
@@ -44,7 +47,11 @@ impl SphPipeline {
             prefix_sum: Stage::new(d, &stages::PREFIX_SUM, &[]),
             grid_scatter: Stage::new(d, &stages::GRID_SCATTER, &[]),
             cell_sort: Stage::new(d, &stages::CELL_SORT, &[]),
-            reorder: Stage::new(d, &stages::REORDER, &[]),
+            reorder: Stage::new(
+                d,
+                &stages::REORDER,
+                &[("WITH_PREVIOUS", f64::from(u8::from(verlet)))],
+            ),
             forces_predict: Stage::new(
                 d,
                 &stages::FORCES_WCSPH,
@@ -58,6 +65,8 @@ impl SphPipeline {
             dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
             symplectic_predictor: Stage::new(d, &stages::SYMPLECTIC_PREDICTOR, &[]),
             symplectic_corrector: Stage::new(d, &stages::SYMPLECTIC_CORRECTOR, &[]),
+            verlet_update: Stage::new(d, &stages::VERLET_UPDATE, &[]),
+            verlet,
             probe_interpolate: Stage::new(d, &stages::PROBE_INTERPOLATE, &stencil),
             observe_reduce: Stage::new(d, &stages::OBSERVE_REDUCE, &[]),
         }
@@ -76,6 +85,7 @@ pub struct GpuBuffers {
     pub a: StateBuffers,
     pub b: StateTextures,
     pub b_ids: wgpu::Buffer,
+    pub b_vel_rho_prev: wgpu::Buffer,
     /// A copy of `a` taken at the start of each chunk, restored after a blow-up.
     pub snapshot: StateBuffers,
     pub c: StateTextures,
@@ -96,6 +106,8 @@ pub struct StateBuffers {
     pub positions: wgpu::Buffer,
     pub vel_rho: wgpu::Buffer,
     pub ids: wgpu::Buffer,
+    /// Velocity and density of the step before (the Verlet integrator's second sequence).
+    pub vel_rho_prev: wgpu::Buffer,
 }
 
 pub struct StateTextures {
@@ -177,10 +189,12 @@ impl GpuBuffers {
             params,
             b,
             b_ids: storage(gpu, "b.ids", n * 4),
+            b_vel_rho_prev: storage(gpu, "b.vel_rho_prev", n * VEC4_BYTES),
             snapshot: StateBuffers {
                 positions: storage(gpu, "snapshot.positions", n * VEC4_BYTES),
                 vel_rho: storage(gpu, "snapshot.vel_rho", n * VEC4_BYTES),
                 ids: storage(gpu, "snapshot.ids", n * 4),
+                vel_rho_prev: storage(gpu, "snapshot.vel_rho_prev", n * VEC4_BYTES),
             },
             c: StateTextures::new(gpu, "c", n),
             forces: storage(gpu, "forces", n * VEC4_BYTES),
@@ -210,6 +224,7 @@ pub struct Bindings {
     dt_update: wgpu::BindGroup,
     symplectic_predictor: wgpu::BindGroup,
     symplectic_corrector: wgpu::BindGroup,
+    verlet_update: wgpu::BindGroup,
     probe_interpolate: wgpu::BindGroup,
     observe_reduce: wgpu::BindGroup,
     n_particles: u32,
@@ -265,6 +280,8 @@ impl SphPipeline {
                     &g.b.positions,
                     &g.b.vel_rho,
                     &g.b_ids,
+                    &g.a.vel_rho_prev,
+                    &g.b_vel_rho_prev,
                 ],
             ),
             forces_predict: self.forces_predict.bind(
@@ -317,6 +334,22 @@ impl SphPipeline {
                     &g.a.ids,
                 ],
             ),
+            verlet_update: self.verlet_update.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.forces,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.b_vel_rho_prev,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.a.vel_rho_prev,
+                ],
+            ),
             probe_interpolate: self.probe_interpolate.bind(
                 d,
                 &[
@@ -361,20 +394,25 @@ impl SphPipeline {
         self.reorder.record(pass, 0, &b.reorder, groups(n, 128));
     }
 
-    /// One symplectic step (DualSPHysics): sort, forces at n, dt, predictor to n + 1/2,
-    /// forces at n + 1/2, corrector to n + 1.
+    /// One step: sort, forces at n, dt, then either the symplectic predictor, forces at
+    /// n + 1/2 and corrector, or the Verlet update (both as in DualSPHysics).
     pub fn record_step(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         self.record_sort(pass, b);
         self.forces_predict
             .record(pass, 0, &b.forces_predict, groups(n, 64));
         self.dt_update.record(pass, 0, &b.dt_update, 1);
-        self.symplectic_predictor
-            .record(pass, 0, &b.symplectic_predictor, groups(n, 128));
-        self.forces_correct
-            .record(pass, 0, &b.forces_correct, groups(n, 64));
-        self.symplectic_corrector
-            .record(pass, 0, &b.symplectic_corrector, groups(n, 128));
+        if self.verlet {
+            self.verlet_update
+                .record(pass, 0, &b.verlet_update, groups(n, 128));
+        } else {
+            self.symplectic_predictor
+                .record(pass, 0, &b.symplectic_predictor, groups(n, 128));
+            self.forces_correct
+                .record(pass, 0, &b.forces_correct, groups(n, 64));
+            self.symplectic_corrector
+                .record(pass, 0, &b.symplectic_corrector, groups(n, 128));
+        }
     }
 
     /// Forces at the current state only (no integration): for tests against the CPU oracle.

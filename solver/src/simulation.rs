@@ -4,7 +4,7 @@
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s).
 
 use crate::case::{self, Derived, Particles, WALL_PHASE};
-use crate::config::{Case, DensityDiffusion, Viscosity};
+use crate::config::{Case, DensityDiffusion, Integrator, Viscosity};
 use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use crate::gpu::params::*;
 use crate::gpu::{GpuContext, GpuError};
@@ -161,6 +161,7 @@ impl Simulation {
             positions: storage_init(&gpu, "a.positions", &particles.positions),
             vel_rho: storage_init(&gpu, "a.vel_rho", &particles.vel_rho),
             ids: storage_init(&gpu, "a.ids", &particles.ids),
+            vel_rho_prev: storage_init(&gpu, "a.vel_rho_prev", &particles.vel_rho),
         };
         let buffers = GpuBuffers::new(
             &gpu,
@@ -174,7 +175,8 @@ impl Simulation {
             0,
             bytemuck::cast_slice(&probes.points),
         );
-        let pipeline = SphPipeline::new(&gpu, case.dimension);
+        let verlet = matches!(case.numerics.integrator, Integrator::Verlet { .. });
+        let pipeline = SphPipeline::new(&gpu, case.dimension, verlet);
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
         Ok(Simulation {
             gpu,
@@ -303,6 +305,7 @@ impl Simulation {
             (&from.positions, &to.positions),
             (&from.vel_rho, &to.vel_rho),
             (&from.ids, &to.ids),
+            (&from.vel_rho_prev, &to.vel_rho_prev),
         ] {
             encoder.copy_buffer_to_buffer(src, 0, dst, 0, src.size());
         }
@@ -315,7 +318,8 @@ impl Simulation {
         if rel_target <= 0.0 {
             return Ok(());
         }
-        let init = StepState::chunk(rel_target, self.last_dt_s as f32);
+        let step_base = (self.steps % u64::from(self.params.euler_every)) as u32;
+        let init = StepState::chunk(rel_target, self.last_dt_s as f32, step_base);
         self.gpu
             .queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
@@ -419,7 +423,7 @@ impl Simulation {
     /// advancing: the GPU side of the force-stage test.
     pub fn compute_forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
-        let open = StepState::chunk(f32::MAX, 0.0);
+        let open = StepState::chunk(f32::MAX, 0.0, 0);
         self.gpu
             .queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&open));
@@ -585,6 +589,11 @@ fn sim_params(
         rho_ratio_max: RHO_RATIO_MAX,
         vertical_axis: (d - 1) as u32,
         n_probes,
+        euler_every: match case.numerics.integrator {
+            Integrator::Verlet { euler_every_steps } => euler_every_steps,
+            Integrator::Symplectic => 1,
+        },
+        pad: [0; 3],
         phases,
         tait_b,
     }

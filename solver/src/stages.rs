@@ -110,6 +110,8 @@ pub const REORDER: StageSpec = StageSpec {
         ("sorted_positions", 5, TextureWrite),
         ("sorted_vel_rho", 6, TextureWrite),
         ("sorted_ids", 7, ReadWrite),
+        ("vel_rho_prev", 8, Read),
+        ("sorted_vel_rho_prev", 9, ReadWrite),
     ],
     entry_points: &["reorder"],
     workgroup: 128,
@@ -177,6 +179,27 @@ pub const SYMPLECTIC_CORRECTOR: StageSpec = StageSpec {
     workgroup: 128,
 };
 
+pub const VERLET_UPDATE: StageSpec = StageSpec {
+    name: "verlet_update",
+    shader: "stages/verlet_update.wgsl",
+    imports: INTEGRATE,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("state", 1, ReadWrite),
+        ("forces", 2, Read),
+        ("positions_n", 3, Texture),
+        ("vel_rho_n", 4, Texture),
+        ("ids_n", 5, Read),
+        ("vel_rho_before", 6, Read),
+        ("positions_out", 7, ReadWrite),
+        ("vel_rho_out", 8, ReadWrite),
+        ("ids_out", 9, ReadWrite),
+        ("vel_rho_prev_out", 10, ReadWrite),
+    ],
+    entry_points: &["verlet_update"],
+    workgroup: 128,
+};
+
 pub const PROBE_INTERPOLATE: StageSpec = StageSpec {
     name: "probe_interpolate",
     shader: "stages/probe_interpolate.wgsl",
@@ -219,6 +242,7 @@ pub const ALL: &[&StageSpec] = &[
     &DT_UPDATE,
     &SYMPLECTIC_PREDICTOR,
     &SYMPLECTIC_CORRECTOR,
+    &VERLET_UPDATE,
     &PROBE_INTERPOLATE,
     &OBSERVE_REDUCE,
 ];

@@ -133,9 +133,22 @@ fn assert_mass_conserved(sim: &Simulation, now: &Particles) {
 /// Without the shift the errors are printed too.
 #[test]
 fn dambreak_front_follows_martin_moyce() {
+    check_dambreak_front(flume_solver::config::Integrator::Symplectic);
+}
+
+/// The same with DualSPHysics' default Verlet integrator.
+#[test]
+fn dambreak_front_follows_martin_moyce_with_verlet() {
+    check_dambreak_front(flume_solver::config::Integrator::Verlet {
+        euler_every_steps: 40,
+    });
+}
+
+fn check_dambreak_front(integrator: flume_solver::config::Integrator) {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let mut c = case("../launch_configs/dambreak_water.yaml");
+    c.numerics.integrator = integrator;
     // The coarsest resolution that passes: a / dp = 25.
     c.numerics.dp_m = 0.004;
     let a = c.fluid_blocks[0].max_m[0] - c.fluid_blocks[0].min_m[0];
@@ -166,7 +179,7 @@ fn dambreak_front_follows_martin_moyce() {
         .expect("shifts");
     for (t, z) in &data {
         eprintln!(
-            "T = {t:.3}: Martin & Moyce Z/a = {z:.3}; SPH {:.3} ({:+.1} %), with dT = {shift:.2}: {:.3} ({:+.1} %)",
+            "{integrator:?}: T = {t:.3}: Martin & Moyce Z/a = {z:.3}; SPH {:.3} ({:+.1} %), with dT = {shift:.2}: {:.3} ({:+.1} %)",
             interpolate(&curve, *t),
             (interpolate(&curve, *t) / z - 1.0) * 100.0,
             interpolate(&curve, t - shift),

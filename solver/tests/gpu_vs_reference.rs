@@ -265,3 +265,71 @@ fn probe_interpolate_and_observe_reduce_match_the_cpu() {
     assert!((obs.max_speed_m_per_s - f64::from(speed)).abs() <= 1e-6 * f64::from(speed));
     assert_eq!(obs.fluid_particles as usize, fluid.len());
 }
+
+/// Two Verlet steps, the first an Euler step (as every run's first is), the second a leapfrog
+/// step from the previous velocity, against the CPU oracle; tolerances as for the symplectic
+/// step (each step here takes one force pass, and there are two steps).
+#[test]
+fn two_verlet_steps_match_the_cpu_steps() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("tests/cases/hydrostatic_2d.yaml");
+    c.numerics.integrator = flume_solver::config::Integrator::Verlet {
+        euler_every_steps: 40,
+    };
+    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+    let particles = common::perturbed(&sim0, 0.3, 17);
+    let mut sim =
+        Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    let dt = 2.0e-5f32;
+    sim.advance_to(f64::from(dt)).expect("step 1");
+    sim.advance_to(f64::from(2.0 * dt)).expect("step 2");
+    assert_eq!(sim.steps(), 2);
+    let after = sim.read_particles().expect("readback");
+
+    let f0 = interaction::interact(&params, &particles.positions, &particles.vel_rho);
+    let (p1, v1, prev1) = integrate::verlet(
+        &params.phases,
+        dt,
+        true,
+        &particles.positions,
+        &particles.vel_rho,
+        &particles.vel_rho,
+        &f0.forces,
+    );
+    let f1 = interaction::interact(&params, &p1, &v1);
+    let (p2, v2, _) = integrate::verlet(&params.phases, dt, false, &p1, &v1, &prev1, &f1.forces);
+    let a_max = [&f0.forces, &f1.forces]
+        .iter()
+        .flat_map(|f| [max_abs(f, 0), max_abs(f, 1)])
+        .fold(0.0f32, f32::max);
+    let drho_max = max_abs(&f0.forces, 3).max(max_abs(&f1.forces, 3));
+    for (i, ((gp, cp), (gv, cv))) in after
+        .positions
+        .iter()
+        .zip(&p2)
+        .zip(after.vel_rho.iter().zip(&v2))
+        .enumerate()
+    {
+        for k in 0..2 {
+            let allowed = 4.0 * f32::EPSILON * cp[k].abs() + 2e-4 * a_max * 4.0 * dt * dt;
+            assert!(
+                (gp[k] - cp[k]).abs() <= allowed,
+                "position of particle {i}[{k}]: gpu {} cpu {}",
+                gp[k],
+                cp[k]
+            );
+        }
+        for k in 0..4 {
+            let rate = if k == 3 { drho_max } else { a_max };
+            let allowed = 4.0 * f32::EPSILON * cv[k].abs() + 2e-4 * rate * 3.0 * dt;
+            assert!(
+                (gv[k] - cv[k]).abs() <= allowed,
+                "velocity/density of particle {i}[{k}]: gpu {} cpu {}",
+                gv[k],
+                cv[k]
+            );
+        }
+    }
+}

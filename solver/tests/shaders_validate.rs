@@ -188,6 +188,7 @@ fn rust_mirrors_have_the_wgsl_layout() {
         rho_ratio_max,
         vertical_axis,
         n_probes,
+        euler_every,
         phases,
         tait_b
     );
@@ -206,7 +207,7 @@ fn rust_mirrors_have_the_wgsl_layout() {
         dt_min_bits,
         status,
         last_dt,
-        pad
+        step_base
     );
 
     let observe = ALL

@@ -37,6 +37,8 @@ pub struct SimParams {
     pub rho_ratio_max: f32,
     pub vertical_axis: u32,
     pub n_probes: u32,
+    pub euler_every: u32,
+    pub pad: [u32; 3],
     pub phases: [PhaseParams; MAX_PHASES],
     pub tait_b: [f32; 4],
 }
@@ -58,12 +60,13 @@ pub struct StepState {
     pub dt_min_bits: u32,
     pub status: u32,
     pub last_dt: f32,
-    pub pad: u32,
+    pub step_base: u32,
 }
 
 impl StepState {
-    /// The state at the start of a chunk that ends `t_target` seconds later.
-    pub fn chunk(t_target: f32, last_dt: f32) -> StepState {
+    /// The state at the start of a chunk that ends `t_target` seconds later, `step_base` steps
+    /// (modulo the Verlet Euler period) after the start of the run.
+    pub fn chunk(t_target: f32, last_dt: f32, step_base: u32) -> StepState {
         StepState {
             dt: 0.0,
             t_rel: 0.0,
@@ -72,7 +75,7 @@ impl StepState {
             dt_min_bits: f32::MAX.to_bits(),
             status: 0,
             last_dt,
-            pad: 0,
+            step_base,
         }
     }
 }

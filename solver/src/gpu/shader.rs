@@ -29,6 +29,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "stages/dt_update.wgsl",
     "stages/symplectic_predictor.wgsl",
     "stages/symplectic_corrector.wgsl",
+    "stages/verlet_update.wgsl",
     "stages/probe_interpolate.wgsl",
     "stages/observe_reduce.wgsl",
 ];

@@ -1,0 +1,63 @@
+// Verlet time integration as in DualSPHysics (Verlet 1967), one force pass a step:
+// x(n+1) = x(n) + dt v(n) + dt^2 / 2 a(n), v(n+1) = v(n-1) + 2 dt a(n), rho(n+1) = rho(n-1) + 2 dt drho(n);
+// every `euler_every` steps (and the first) an Euler step v(n+1) = v(n) + dt a(n),
+// rho(n+1) = rho(n) + dt drho(n) brings the two interleaved sequences back together.
+// Walls (DBC) keep position and velocity and never drop below rho0. Writes the new state,
+// in cell order, to the state buffers and the current one to `vel_rho_prev`.
+// Reference: solver/src/physics/integrate.rs.
+
+@group(0) @binding(1) var<storage, read_write> state: StepState;
+@group(0) @binding(2) var<storage, read> forces: array<vec4<f32>>;
+@group(0) @binding(3) var positions_n: texture_2d<f32>;
+@group(0) @binding(4) var vel_rho_n: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> ids_n: array<u32>;
+@group(0) @binding(6) var<storage, read> vel_rho_before: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read_write> positions_out: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> vel_rho_out: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
+@group(0) @binding(10) var<storage, read_write> vel_rho_prev_out: array<vec4<f32>>;
+
+@compute @workgroup_size(128)
+fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    let dt = state.dt;
+    if (i >= params.n_particles || dt == 0.0) {
+        return;
+    }
+    let p = textureLoad(positions_n, texel(i), 0);
+    let vr = textureLoad(vel_rho_n, texel(i), 0);
+    let f = forces[i];
+    let phase = bitcast<u32>(p.w);
+    let ph = params.phases[phase];
+    // dt_update has counted this step already.
+    let euler = (state.step_base + state.steps - 1u) % params.euler_every == 0u;
+    var base = vel_rho_before[i];
+    var span = 2.0 * dt;
+    if (euler) {
+        base = vr;
+        span = dt;
+    }
+    let rho = base.w + span * f.w;
+    ids_out[i] = ids_n[i];
+    vel_rho_prev_out[i] = vr;
+    if (ph.mobile > 0.5) {
+        let v = base.xyz + span * f.xyz;
+        let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
+        positions_out[i] = vec4<f32>(x, p.w);
+        vel_rho_out[i] = vec4<f32>(v, rho);
+        var flags = 0u;
+        let s = dot(x, x) + dot(v, v) + rho;
+        // NaN compares false with everything; infinities exceed the largest finite f32.
+        if (!(abs(s) <= 3.0e38)) {
+            flags |= STATUS_NON_FINITE;
+        } else if (abs(rho / ph.rho0 - 1.0) > params.rho_ratio_max) {
+            flags |= STATUS_DENSITY_RUNAWAY;
+        }
+        if (flags != 0u) {
+            atomicOr(&state.status, flags);
+        }
+    } else {
+        positions_out[i] = p;
+        vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));
+    }
+}
