@@ -45,17 +45,7 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
         let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
         positions_out[i] = vec4<f32>(x, p.w);
         vel_rho_out[i] = vec4<f32>(v, rho);
-        var flags = 0u;
-        let s = dot(x, x) + dot(v, v) + rho;
-        // NaN compares false with everything; infinities exceed the largest finite f32.
-        if (!(abs(s) <= 3.0e38)) {
-            flags |= STATUS_NON_FINITE;
-        } else if (abs(rho / ph.rho0 - 1.0) > params.rho_ratio_max) {
-            flags |= STATUS_DENSITY_RUNAWAY;
-        }
-        if (flags != 0u) {
-            atomicOr(&state.status, flags);
-        }
+        check_health(x, v, rho, ph.rho0);
     } else {
         positions_out[i] = p;
         vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));

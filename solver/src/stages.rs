@@ -24,6 +24,7 @@ const INTEGRATE: &[&str] = &[
     "common/params.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
+    "common/health.wgsl",
 ];
 
 pub const GRID_CLEAR: StageSpec = StageSpec {

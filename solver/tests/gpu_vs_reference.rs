@@ -183,37 +183,48 @@ fn one_symplectic_step_matches_the_cpu_step() {
         &vel_h,
         &f_h.forces,
     );
-    // Displacements are ~1e-5 m on positions ~0.1 m, so positions agree only to their own
-    // rounding (a few ulp of the coordinate) plus what the accelerations' tolerance (1e-4 of
-    // the largest, ~1e4 m/s2 in this perturbed state, for each of two passes) moves a particle
-    // in one step, a dt^2.
-    let a_max = max_abs(&f_n.forces, 0)
-        .max(max_abs(&f_n.forces, 1))
-        .max(max_abs(&f_h.forces, 0))
-        .max(max_abs(&f_h.forces, 1));
-    for (i, (g, c)) in after.positions.iter().zip(&pos_1).enumerate() {
+    assert_step_close(&after, &pos_1, &vel_1, &[&f_n.forces, &f_h.forces], dt, 1.0);
+}
+
+/// Compares a GPU state after `steps` steps of `dt` with the CPU's. Displacements are ~1e-5 m on
+/// positions ~0.1 m, so positions agree only to their own rounding (a few ulp) plus what the
+/// force passes' tolerance (1e-4 of the largest rate, ~1e4 m/s2 in these perturbed states)
+/// moves a particle over the steps; velocities and densities within that tolerance times dt.
+fn assert_step_close(
+    after: &flume_solver::case::Particles,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+    passes: &[&Vec<[f32; 4]>],
+    dt: f32,
+    steps: f32,
+) {
+    let rel = 1e-4 * passes.len() as f32;
+    let a_max = passes
+        .iter()
+        .flat_map(|f| [max_abs(f, 0), max_abs(f, 1)])
+        .fold(0.0f32, f32::max);
+    let drho_max = passes.iter().map(|f| max_abs(f, 3)).fold(0.0f32, f32::max);
+    let t = steps * dt;
+    for (i, (g, c)) in after.positions.iter().zip(pos).enumerate() {
         for k in 0..2 {
-            let allowed = 4.0 * f32::EPSILON * c[k].abs() + 2e-4 * a_max * dt * dt;
+            let allowed = 4.0 * f32::EPSILON * c[k].abs() + rel * a_max * t * t;
             let err = (g[k] - c[k]).abs();
             assert!(
                 err <= allowed,
-                "position of particle {i}, component {k}: gpu {} cpu {} (allowed {allowed:.2e})",
+                "position of particle {i}[{k}]: gpu {} cpu {} (allowed {allowed:.2e})",
                 g[k],
                 c[k]
             );
         }
     }
-    // Velocity and density move by dt times the rates of two force passes, each within 1e-4 of
-    // the largest rate: 2e-4 for the pair.
-    let drho_max = max_abs(&f_n.forces, 3).max(max_abs(&f_h.forces, 3));
-    for (i, (g, c)) in after.vel_rho.iter().zip(&vel_1).enumerate() {
+    for (i, (g, c)) in after.vel_rho.iter().zip(vel_rho).enumerate() {
         for k in 0..4 {
             let rate = if k == 3 { drho_max } else { a_max };
-            let allowed = 4.0 * f32::EPSILON * c[k].abs() + 2e-4 * rate * dt;
+            let allowed = 4.0 * f32::EPSILON * c[k].abs() + rel * rate * t;
             let err = (g[k] - c[k]).abs();
             assert!(
                 err <= allowed,
-                "velocity/density of particle {i}, component {k}: gpu {} cpu {} (allowed {allowed:.2e})",
+                "velocity/density of particle {i}[{k}]: gpu {} cpu {} (allowed {allowed:.2e})",
                 g[k],
                 c[k]
             );
@@ -300,36 +311,5 @@ fn two_verlet_steps_match_the_cpu_steps() {
     );
     let f1 = interaction::interact(&params, &p1, &v1);
     let (p2, v2, _) = integrate::verlet(&params.phases, dt, false, &p1, &v1, &prev1, &f1.forces);
-    let a_max = [&f0.forces, &f1.forces]
-        .iter()
-        .flat_map(|f| [max_abs(f, 0), max_abs(f, 1)])
-        .fold(0.0f32, f32::max);
-    let drho_max = max_abs(&f0.forces, 3).max(max_abs(&f1.forces, 3));
-    for (i, ((gp, cp), (gv, cv))) in after
-        .positions
-        .iter()
-        .zip(&p2)
-        .zip(after.vel_rho.iter().zip(&v2))
-        .enumerate()
-    {
-        for k in 0..2 {
-            let allowed = 4.0 * f32::EPSILON * cp[k].abs() + 2e-4 * a_max * 4.0 * dt * dt;
-            assert!(
-                (gp[k] - cp[k]).abs() <= allowed,
-                "position of particle {i}[{k}]: gpu {} cpu {}",
-                gp[k],
-                cp[k]
-            );
-        }
-        for k in 0..4 {
-            let rate = if k == 3 { drho_max } else { a_max };
-            let allowed = 4.0 * f32::EPSILON * cv[k].abs() + 2e-4 * rate * 3.0 * dt;
-            assert!(
-                (gv[k] - cv[k]).abs() <= allowed,
-                "velocity/density of particle {i}[{k}]: gpu {} cpu {}",
-                gv[k],
-                cv[k]
-            );
-        }
-    }
+    assert_step_close(&after, &p2, &v2, &[&f0.forces, &f1.forces], dt, 2.0);
 }

@@ -19,6 +19,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "common/neighbours.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
+    "common/health.wgsl",
     "stages/grid_clear.wgsl",
     "stages/grid_count.wgsl",
     "stages/prefix_sum.wgsl",
