@@ -163,19 +163,16 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
     for_each_point(&wlo, &whi, |p| {
         if is_wall(case, p, &lo, &hi) {
             taken.insert(p.to_vec());
-            // Walls under a fluid block start at its hydrostatic density, so that the fluid
-            // does not first sink into walls at rest density; walls elsewhere start at rho0.
+            // Walls under fluid start at the hydrostatic density of what lies above them, so
+            // that the fluid does not first sink into walls at rest density.
             let x: Vec<f64> = p.iter().map(|v| *v as f64 * dp).collect();
-            let depth = case
-                .fluid_blocks
-                .iter()
-                .filter(|b| {
-                    (0..d - 1).all(|k| x[k] >= b.min_m[k] - reach && x[k] <= b.max_m[k] + reach)
-                })
-                .map(|b| b.max_m[d - 1] - x[d - 1])
-                .fold(0.0f64, f64::max);
-            let rho = wall.rho0 * (1.0 + wall.rho0 * gravity * depth / wall_b).powf(1.0 / 7.0);
-            push(p, WALL_PHASE, rho, &mut out);
+            let pressure = hydrostatic_pressure(case, &x, reach, gravity);
+            push(
+                p,
+                WALL_PHASE,
+                tait_density(wall.rho0, wall_b, pressure),
+                &mut out,
+            );
         }
     });
     for block in &case.fluid_blocks {
@@ -185,18 +182,52 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
         let phase = k as u32 + 1;
         let props = derived.phases[phase as usize];
         let b = tait_b(derived.c0, props.rho0);
-        let top = block.max_m[d - 1];
         let (blo, bhi) = block_bounds(case, &block.min_m, &block.max_m);
         for_each_point(&blo, &bhi, |p| {
             if taken.insert(p.to_vec()) {
-                // Hydrostatic start (inverse Tait law) so the column does not first bounce.
-                let depth = (top - p[d - 1] as f64 * dp).max(0.0);
-                let rho = props.rho0 * (1.0 + props.rho0 * gravity * depth / b).powf(1.0 / 7.0);
-                push(p, phase, rho, &mut out);
+                // Hydrostatic start so that the column does not first bounce.
+                let x: Vec<f64> = p.iter().map(|v| *v as f64 * dp).collect();
+                let pressure = hydrostatic_pressure(case, &x, 0.0, gravity);
+                push(p, phase, tait_density(props.rho0, b, pressure), &mut out);
             }
         });
     }
     out
+}
+
+/// Pressure at `x` of the fluid blocks above it at rest, Pa: each block whose horizontal
+/// extent (widened by `reach`) holds `x` adds rho0 g times the part of its height above `x`.
+/// Blocks are taken as layers that do not overlap (a sediment bed under water, say). Below
+/// the lowest block (wall particles) the lowest block's gradient carries on, so that the
+/// walls' pressure keeps rising with depth as DBC needs to hold the fluid up.
+fn hydrostatic_pressure(case: &Case, x: &[f64], reach: f64, gravity: f64) -> f64 {
+    let d = x.len();
+    let z = x[d - 1];
+    let mut pressure = 0.0;
+    let mut lowest: Option<(f64, f64)> = None;
+    for b in case
+        .fluid_blocks
+        .iter()
+        .filter(|b| (0..d - 1).all(|k| x[k] >= b.min_m[k] - reach && x[k] <= b.max_m[k] + reach))
+    {
+        let rho0 = case
+            .phase_index(&b.phase)
+            .map_or(0.0, |k| case.phases[k].rho0_kg_per_m3);
+        let bottom = b.min_m[d - 1];
+        pressure += rho0 * gravity * (b.max_m[d - 1] - z.max(bottom)).max(0.0);
+        if lowest.is_none_or(|(low, _)| bottom < low) {
+            lowest = Some((bottom, rho0));
+        }
+    }
+    match lowest {
+        Some((bottom, rho0)) if z < bottom => pressure + rho0 * gravity * (bottom - z),
+        _ => pressure,
+    }
+}
+
+/// The density at which the Tait equation gives `pressure`.
+fn tait_density(rho0: f64, b: f64, pressure: f64) -> f64 {
+    rho0 * (1.0 + pressure / b).powf(1.0 / 7.0)
 }
 
 /// Number of particles `generate` would make, without making them (for limit checks).

@@ -59,6 +59,49 @@ fn hydrostatic_tank_3d_pressure_follows_depth() {
     check_hydrostatic("tests/cases/hydrostatic_3d.yaml", &[0.2, 0.25]);
 }
 
+/// Phases are data: a dense phase under water keeps the two-layer hydrostatic profile, within
+/// the same 2 % as one phase (the interface lies halfway between the two blocks' lattices).
+#[test]
+fn two_phases_at_rest_keep_the_layered_hydrostatic_pressure() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case("tests/cases/two_layer_2d.yaml");
+    let g = c.gravity_magnitude();
+    let (rho_w, rho_s) = (c.phases[0].rho0_kg_per_m3, c.phases[1].rho0_kg_per_m3);
+    let interface = c.fluid_blocks[0].max_m[1] + 0.5 * c.numerics.dp_m;
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    for t in [0.3, 0.35] {
+        sim.advance_to(t).expect("runs");
+        let obs = sim.observe().expect("observes");
+        assert!(
+            obs.max_speed_m_per_s < 0.05,
+            "t={t}: the layers are moving at {} m/s",
+            obs.max_speed_m_per_s
+        );
+        let level = obs.gauges[0].level_m.expect("gauge in water");
+        for (probe, cfg) in obs.probes.iter().zip(&c.observations.pressure_probes) {
+            let z = cfg.position_m[1];
+            let expected = if z < interface {
+                rho_w * g * (level - interface) + rho_s * g * (interface - z)
+            } else {
+                rho_w * g * (level - z)
+            };
+            let p = probe.pressure_pa.expect("probe in fluid");
+            let err = p / expected - 1.0;
+            eprintln!(
+                "two layers t={t:.2} z={z:.3}: p = {p:.1} Pa, expected {expected:.1} Pa ({:+.2} %)",
+                err * 100.0
+            );
+            assert!(
+                err.abs() <= 0.02,
+                "t={t} probe {}: {:+.2} %",
+                cfg.name,
+                err * 100.0
+            );
+        }
+    }
+}
+
 fn read_front(path: &str) -> Vec<(f64, f64)> {
     std::fs::read_to_string(common::validation_path(path))
         .expect("validation data")
