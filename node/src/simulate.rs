@@ -212,7 +212,11 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
             .map_or("dry".to_string(), |v| format!("{v:.1} Pa"));
         t.row([format!("probe {}", p.name), pressure]);
     }
-    t.row(["front".to_string(), format!("{:.4} m", last.front_m)]);
+    t.row([
+        "front".to_string(),
+        last.front_m
+            .map_or_else(|| "no fluid".to_string(), |x| format!("{x:.4} m")),
+    ]);
     t.row([
         "max density error".to_string(),
         format!("{:.3e}", last.max_density_error),

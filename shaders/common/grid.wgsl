@@ -1,5 +1,5 @@
-// Cell-linked list geometry: cells of size 2h, numbered x fastest, so the three cells
-// (x-1, x, x+1) of one row are contiguous in the sorted particle arrays.
+// Cell-linked list geometry: cells of size 2h / CELL_DIVISIONS (see neighbours.wgsl), numbered
+// x fastest, so the cells of one stencil row are contiguous in the sorted particle arrays.
 
 fn cell_coords(p: vec3<f32>) -> vec3<i32> {
     let c = floor((p - params.grid_origin.xyz) * params.grid_origin.w);

@@ -18,6 +18,9 @@ fn dt_update() {
         state.dt = 0.0;
         return;
     }
+    // The CFL step, before it is shortened to land on the target: what the next chunk's
+    // number of steps is estimated from.
+    state.last_dt = dt;
     var t_next = state.t_rel + dt;
     if (dt >= remaining) {
         dt = remaining;
@@ -28,7 +31,8 @@ fn dt_update() {
         t_next = state.t_rel + dt;
     }
     state.dt = dt;
-    state.last_dt = dt;
+    state.dt_prev = state.dt_taken;
+    state.dt_taken = dt;
     state.t_rel = t_next;
     state.steps += 1u;
 }

@@ -17,7 +17,8 @@
 @compute @workgroup_size(128)
 fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_particles) {
+    // An idle step (past the chunk's end, or after a blow-up) leaves the state as it is.
+    if (i >= params.n_particles || state.dt == 0.0) {
         return;
     }
     let dt = state.dt;

@@ -13,7 +13,8 @@
 @compute @workgroup_size(128)
 fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_particles) {
+    // An idle step (past the chunk's end, or after a blow-up) leaves the state as it is.
+    if (i >= params.n_particles || state.dt == 0.0) {
         return;
     }
     let half_dt = 0.5 * state.dt;

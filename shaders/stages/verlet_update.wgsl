@@ -1,5 +1,7 @@
 // Verlet time integration as in DualSPHysics (Verlet 1967), one force pass a step:
-// x(n+1) = x(n) + dt v(n) + dt^2 / 2 a(n), v(n+1) = v(n-1) + 2 dt a(n), rho(n+1) = rho(n-1) + 2 dt drho(n);
+// x(n+1) = x(n) + dt v(n) + dt^2 / 2 a(n), v(n+1) = v(n-1) + (dt_prev + dt) a(n),
+// rho(n+1) = rho(n-1) + (dt_prev + dt) drho(n), the leapfrog over the two steps actually taken
+// (they differ where a step is shortened to land on an output time);
 // every `euler_every` steps (and the first) an Euler step v(n+1) = v(n) + dt a(n),
 // rho(n+1) = rho(n) + dt drho(n) brings the two interleaved sequences back together.
 // Walls (DBC) keep position and velocity and never drop below rho0. Writes the new state,
@@ -32,7 +34,7 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     // dt_update has counted this step already.
     let euler = (state.step_base + state.steps - 1u) % params.euler_every == 0u;
     var base = vel_rho_before[i];
-    var span = 2.0 * dt;
+    var span = state.dt_prev + dt;
     if (euler) {
         base = vr;
         span = dt;

@@ -284,9 +284,13 @@ pub fn derive(case: &Case) -> Derived {
             c0_m_per_s: Some(c),
             ..
         } => c,
-        SoundSpeed { coefsound, .. } => {
-            coefsound.unwrap_or(10.0) * (case.gravity_magnitude() * fluid_height).sqrt()
-        }
+        // A validated case gives exactly one of the two; a case built in code without either
+        // gets MODEL.md's usual c0 = 10 u_max.
+        SoundSpeed { coefsound, .. } => crate::physics::eos::c0_from_coefsound(
+            coefsound.unwrap_or(10.0),
+            case.gravity_magnitude(),
+            fluid_height,
+        ),
     };
     let vol = dp.powi(d as i32);
     let mut phases = vec![PhaseProps {

@@ -27,12 +27,12 @@ pub struct ProbeReading {
 pub struct Observations {
     pub time_s: f64,
     pub steps: u64,
-    /// The last time step taken, s.
+    /// The CFL time step of the last step (steps landing on an output time are shorter), s.
     pub dt_s: f64,
     pub gauges: Vec<GaugeReading>,
     pub probes: Vec<ProbeReading>,
-    /// Largest x of any fluid particle, m (the surge front of a dam break).
-    pub front_m: f64,
+    /// Largest x of any fluid particle, m (the surge front of a dam break); None without fluid.
+    pub front_m: Option<f64>,
     pub max_speed_m_per_s: f64,
     /// Largest |rho / rho0 - 1| over fluid particles.
     pub max_density_error: f64,
@@ -127,7 +127,7 @@ impl ProbeLayout {
             dt_s,
             gauges,
             probes,
-            front_m: f64::from(from_order_key(ext.front_key)),
+            front_m: (ext.fluid_count > 0).then(|| f64::from(from_order_key(ext.front_key))),
             max_speed_m_per_s: f64::from(f32::from_bits(ext.max_speed_bits)),
             max_density_error: f64::from(f32::from_bits(ext.max_rho_err_bits)),
             fluid_particles: ext.fluid_count,

@@ -9,8 +9,10 @@ use crate::gpu::stage::{Stage, groups};
 use crate::gpu::{GpuContext, GpuError};
 use crate::stages::{self, PREFIX_SUM_BLOCK};
 
-/// Cells per kernel support 2h along each axis (see `shaders/common/neighbours.wgsl`): with 2,
-/// the neighbour loops visit about a third fewer candidates than with cells of 2h.
+/// Cells per kernel support 2h along each axis (see `shaders/common/neighbours.wgsl`). With 2
+/// the neighbour loops visit about a third fewer candidates, but on lavapipe the four times
+/// larger cell list cost more than that saved (measured 4.8e5 against 5.6e5 particle-steps/s
+/// on the DualSPHysics case), so cells are 2h wide.
 pub const CELL_DIVISIONS: u32 = 1;
 
 pub struct SphPipeline {
@@ -124,7 +126,7 @@ impl StateTextures {
     }
 }
 
-/// Bytes per particle and per cell of `GpuBuffers`, for the up-front size check.
+/// Bytes of one vec4<f32> particle attribute (positions, velocity-density, forces).
 pub const VEC4_BYTES: u64 = 16;
 
 impl GpuBuffers {
@@ -143,7 +145,9 @@ impl GpuBuffers {
             });
         }
         let max_groups = u64::from(gpu.limits.max_compute_workgroups_per_dimension);
-        if n_particles.div_ceil(64) > max_groups || (n_cells + 1).div_ceil(128) > max_groups {
+        if n_particles.div_ceil(u64::from(stages::FORCES_WCSPH.workgroup)) > max_groups
+            || (n_cells + 1).div_ceil(u64::from(stages::GRID_CLEAR.workgroup)) > max_groups
+        {
             return Err(GpuError::TooLarge {
                 buffer: "dispatch size".to_string(),
                 needed_mib: (n_particles * VEC4_BYTES) as f64 / 1048576.0,
@@ -374,10 +378,8 @@ impl SphPipeline {
     pub fn record_sort(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         let cells = b.n_cells + 1;
-        self.grid_clear
-            .record(pass, 0, &b.grid_clear, groups(cells, 128));
-        self.grid_count
-            .record(pass, 0, &b.grid_count, groups(n, 128));
+        self.grid_clear.record_items(pass, 0, &b.grid_clear, cells);
+        self.grid_count.record_items(pass, 0, &b.grid_count, n);
         // Exclusive scan of the counts into cell starts, level by level, then added back down.
         for (bind, len) in &b.scan {
             self.prefix_sum
@@ -387,11 +389,10 @@ impl SphPipeline {
             self.prefix_sum
                 .record(pass, 1, bind, groups(*len, PREFIX_SUM_BLOCK));
         }
-        self.grid_scatter
-            .record(pass, 0, &b.grid_scatter, groups(n, 128));
+        self.grid_scatter.record_items(pass, 0, &b.grid_scatter, n);
         self.cell_sort
-            .record(pass, 0, &b.cell_sort, groups(b.n_cells, 128));
-        self.reorder.record(pass, 0, &b.reorder, groups(n, 128));
+            .record_items(pass, 0, &b.cell_sort, b.n_cells);
+        self.reorder.record_items(pass, 0, &b.reorder, n);
     }
 
     /// One step: sort, forces at n, dt, then either the symplectic predictor, forces at
@@ -400,18 +401,18 @@ impl SphPipeline {
         let n = b.n_particles;
         self.record_sort(pass, b);
         self.forces_predict
-            .record(pass, 0, &b.forces_predict, groups(n, 64));
-        self.dt_update.record(pass, 0, &b.dt_update, 1);
+            .record_items(pass, 0, &b.forces_predict, n);
+        self.dt_update.record_items(pass, 0, &b.dt_update, 1);
         if self.verlet {
             self.verlet_update
-                .record(pass, 0, &b.verlet_update, groups(n, 128));
+                .record_items(pass, 0, &b.verlet_update, n);
         } else {
             self.symplectic_predictor
-                .record(pass, 0, &b.symplectic_predictor, groups(n, 128));
+                .record_items(pass, 0, &b.symplectic_predictor, n);
             self.forces_correct
-                .record(pass, 0, &b.forces_correct, groups(n, 64));
+                .record_items(pass, 0, &b.forces_correct, n);
             self.symplectic_corrector
-                .record(pass, 0, &b.symplectic_corrector, groups(n, 128));
+                .record_items(pass, 0, &b.symplectic_corrector, n);
         }
     }
 
@@ -419,15 +420,15 @@ impl SphPipeline {
     pub fn record_forces(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
         self.forces_predict
-            .record(pass, 0, &b.forces_predict, groups(b.n_particles, 64));
+            .record_items(pass, 0, &b.forces_predict, b.n_particles);
     }
 
     /// Observation passes: probe sums on the sorted state and the whole-state maxima.
     pub fn record_observe(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
         self.probe_interpolate
-            .record(pass, 0, &b.probe_interpolate, groups(b.n_probes, 64));
+            .record_items(pass, 0, &b.probe_interpolate, b.n_probes);
         self.observe_reduce
-            .record(pass, 0, &b.observe_reduce, groups(b.n_particles, 128));
+            .record_items(pass, 0, &b.observe_reduce, b.n_particles);
     }
 }

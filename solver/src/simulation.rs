@@ -18,6 +18,10 @@ pub enum SolverError {
     Gpu(#[from] GpuError),
     #[error("the case has {0} particles; the solver's indices are 32-bit")]
     TooManyParticles(u64),
+    #[error(
+        "the case's neighbour grid has {0} cells; the solver's cell indices are 32-bit: use a coarser dp or a smaller domain"
+    )]
+    TooManyCells(u64),
     #[error("simulation blew up at t = {time_s:.6} s (step {step}): {health}")]
     BlowUp {
         time_s: f64,
@@ -65,7 +69,8 @@ impl std::fmt::Display for Health {
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
 pub const MAX_RECOVERIES_PER_CHUNK: u32 = 4;
-/// Largest CFL number `set_cfl` accepts; above about 1 the scheme is unstable.
+/// Largest CFL number `set_cfl` accepts. Above about 1 the scheme is unstable: values up to
+/// this are accepted so that an operator (or a test) can see the recovery bring it back down.
 pub const MAX_CFL: f64 = 5.0;
 
 /// A blow-up the solver recovered from by rolling back and shrinking the time step.
@@ -97,12 +102,14 @@ pub struct Simulation {
     time_s: f64,
     steps: u64,
     last_dt_s: f64,
+    /// The last step actually taken, s (the Verlet leapfrog spans it and the next).
+    dt_taken: f32,
     initial_particles: Particles,
     recoveries: Vec<Recovery>,
 }
 
 /// Grid of cells of size 2h / CELL_DIVISIONS covering the tank, its walls and a margin above it.
-fn grid_for(case: &Case, h: f64) -> ([u32; 4], [f32; 4]) {
+fn grid_for(case: &Case, h: f64) -> Result<([u32; 4], [f32; 4]), SolverError> {
     let d = case.dim();
     let cell = 2.0 * h / f64::from(crate::pipeline::CELL_DIVISIONS);
     let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
@@ -115,20 +122,26 @@ fn grid_for(case: &Case, h: f64) -> ([u32; 4], [f32; 4]) {
             // Room above the tank for splashes; particles above the grid still live in its top row.
             hi += 0.25 * (case.domain.max_m[k] - case.domain.min_m[k]);
         }
-        dims[k] = ((hi - lo) / cell).ceil().max(1.0) as u32;
+        dims[k] = ((hi - lo) / cell).ceil().clamp(1.0, f64::from(u32::MAX)) as u32;
         origin[k] = lo as f32;
     }
-    dims[3] = dims[0] * dims[1] * dims[2];
+    let cells = u64::from(dims[0]) * u64::from(dims[1]) * u64::from(dims[2]);
+    // Cell indices and the cell-start table (cells + 1 entries) are u32 on the GPU.
+    dims[3] = u32::try_from(cells)
+        .ok()
+        .filter(|c| *c < u32::MAX)
+        .ok_or(SolverError::TooManyCells(cells))?;
     origin[3] = (1.0 / cell) as f32;
-    (dims, origin)
+    Ok((dims, origin))
 }
 
 impl Simulation {
     pub fn new(gpu: Arc<GpuContext>, case: &Case) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
-        let (grid_dims, _) = grid_for(case, derived.h);
+        let (grid_dims, _) = grid_for(case, derived.h)?;
         let n_cells = u64::from(grid_dims[3]);
         let count = case::count(case);
+        // Particle indices are u32 on the GPU, with headroom for index arithmetic.
         if count >= u64::from(u32::MAX / 2) {
             return Err(SolverError::TooManyParticles(count));
         }
@@ -145,7 +158,7 @@ impl Simulation {
         particles: Particles,
     ) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
-        let (grid_dims, grid_origin) = grid_for(case, derived.h);
+        let (grid_dims, grid_origin) = grid_for(case, derived.h)?;
         GpuBuffers::check_limits(&gpu, particles.len() as u64, u64::from(grid_dims[3]))?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);
@@ -190,6 +203,7 @@ impl Simulation {
             time_s: 0.0,
             steps: 0,
             last_dt_s: 0.0,
+            dt_taken: 0.0,
             initial_particles: particles,
             recoveries: Vec::new(),
         })
@@ -218,6 +232,8 @@ impl Simulation {
     pub fn steps(&self) -> u64 {
         self.steps
     }
+    /// The CFL time step of the last step taken, s (the step that lands on a target time may
+    /// be shorter).
     pub fn last_dt_s(&self) -> f64 {
         self.last_dt_s
     }
@@ -238,7 +254,13 @@ impl Simulation {
                 now_s: self.time_s,
             });
         }
-        let saved = (self.time_s, self.steps, self.last_dt_s);
+        if !target_s.is_finite() {
+            return Err(SolverError::InvalidParameter {
+                name: "target time",
+                reason: format!("must be a finite time in s, got {target_s}"),
+            });
+        }
+        let saved = (self.time_s, self.steps, self.last_dt_s, self.dt_taken);
         self.copy_state(&self.buffers.a, &self.buffers.snapshot);
         let mut tries = 0;
         loop {
@@ -250,7 +272,7 @@ impl Simulation {
                 }) if tries < MAX_RECOVERIES_PER_CHUNK => {
                     tries += 1;
                     self.copy_state(&self.buffers.snapshot, &self.buffers.a);
-                    (self.time_s, self.steps, self.last_dt_s) = saved;
+                    (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
                     self.params.cfl *= 0.5;
                     self.gpu.queue.write_buffer(
                         &self.buffers.params,
@@ -312,34 +334,30 @@ impl Simulation {
         self.gpu.queue.submit([encoder.finish()]);
     }
 
+    /// Steps to `target_s` in submissions of up to `MAX_STEPS_PER_SUBMIT` steps. Each
+    /// submission is a GPU chunk whose time starts at zero, so f32 only ever holds the time
+    /// of a few hundred steps; the host adds it to its f64 clock.
     fn run_chunk(&mut self, target_s: f64) -> Result<(), SolverError> {
-        let chunk_start = self.time_s;
-        let rel_target = (target_s - chunk_start) as f32;
-        if rel_target <= 0.0 {
-            return Ok(());
-        }
-        let step_base = (self.steps % u64::from(self.params.euler_every)) as u32;
-        let init = StepState::chunk(rel_target, self.last_dt_s as f32, step_base);
-        self.gpu
-            .queue
-            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
-        let mut done_steps = 0u32;
-        let mut batch = if self.last_dt_s > 0.0 {
-            ((target_s - chunk_start) / self.last_dt_s)
-                .ceil()
-                .clamp(1.0, f64::from(MAX_STEPS_PER_SUBMIT)) as u32
-        } else {
-            8
-        };
-        loop {
+        let mut batch = self.steps_for(target_s - self.time_s);
+        while target_s > self.time_s {
+            let euler_every = u64::from(self.params.euler_every);
+            let init = StepState::chunk(
+                (target_s - self.time_s) as f32,
+                self.last_dt_s as f32,
+                self.dt_taken,
+                (self.steps % euler_every) as u32,
+            );
+            self.gpu
+                .queue
+                .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
             self.submit_steps(batch);
             let state = self.read_state()?;
-            self.steps += u64::from(state.steps - done_steps);
-            done_steps = state.steps;
+            self.steps += u64::from(state.steps);
             self.last_dt_s = f64::from(state.last_dt);
+            self.dt_taken = state.dt_taken;
             let health = Health(state.status);
             if !health.is_ok() {
-                self.time_s = chunk_start + f64::from(state.t_rel);
+                self.time_s += f64::from(state.t_rel);
                 return Err(SolverError::BlowUp {
                     time_s: self.time_s,
                     step: self.steps,
@@ -348,17 +366,25 @@ impl Simulation {
             }
             if state.t_rel >= state.t_target {
                 self.time_s = target_s;
-                return Ok(());
-            }
-            self.time_s = chunk_start + f64::from(state.t_rel);
-            let remaining = f64::from(state.t_target - state.t_rel);
-            let estimate = if state.last_dt > 0.0 {
-                (remaining / f64::from(state.last_dt)).ceil() as u32
             } else {
-                batch * 2
-            };
-            batch = estimate.clamp(1, MAX_STEPS_PER_SUBMIT);
+                self.time_s += f64::from(state.t_rel);
+            }
+            batch = self.steps_for(target_s - self.time_s);
         }
+        Ok(())
+    }
+
+    /// Steps estimated to cover `span_s` at the last CFL step (or the acoustic bound before
+    /// the first step), clamped to one submission.
+    fn steps_for(&self, span_s: f64) -> u32 {
+        let dt = if self.last_dt_s > 0.0 {
+            self.last_dt_s
+        } else {
+            f64::from(self.params.cfl * self.params.h / self.params.c0)
+        };
+        (span_s / dt)
+            .ceil()
+            .clamp(1.0, f64::from(MAX_STEPS_PER_SUBMIT)) as u32
     }
 
     fn submit_steps(&self, steps: u32) {
@@ -423,7 +449,7 @@ impl Simulation {
     /// advancing: the GPU side of the force-stage test.
     pub fn compute_forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
-        let open = StepState::chunk(f32::MAX, 0.0, 0);
+        let open = StepState::chunk(f32::MAX, 0.0, 0.0, 0);
         self.gpu
             .queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&open));
@@ -563,11 +589,7 @@ fn sim_params(
         DensityDiffusion::MolteniColagrossi2009 { delta } => (DIFFUSION_MOLTENI, delta),
         DensityDiffusion::Fourtakas2019 { delta } => (DIFFUSION_FOURTAKAS, delta),
     };
-    let kernel_ad = if d == 2 {
-        7.0 / (4.0 * std::f64::consts::PI * h * h)
-    } else {
-        21.0 / (16.0 * std::f64::consts::PI * h * h * h)
-    };
+    let kernel_ad = crate::physics::kernel::alpha_d(case.dimension, h as f32);
     SimParams {
         n_particles: n,
         n_cells: grid_dims[3],
@@ -577,7 +599,7 @@ fn sim_params(
         grid_origin,
         gravity,
         h: h as f32,
-        kernel_ad: kernel_ad as f32,
+        kernel_ad,
         c0: derived.c0 as f32,
         eta2: (0.01 * h * h) as f32,
         delta_h_c0: (delta * h * derived.c0) as f32,

@@ -197,12 +197,13 @@ fn check_dambreak_front(integrator: flume_solver::config::Integrator) {
     let a = c.fluid_blocks[0].max_m[0] - c.fluid_blocks[0].min_m[0];
     let scale = (2.0 * c.gravity_magnitude() / a).sqrt();
     let mut sim = Simulation::new(gpu, &c).expect("case builds");
-    let mut curve = vec![(0.0, sim.observe().expect("observes").front_m / a)];
+    let front = |sim: &Simulation| sim.observe().expect("observes").front_m.expect("fluid");
+    let mut curve = vec![(0.0, front(&sim) / a)];
     let steps = 52;
     for k in 1..=steps {
         let t_dimless = 2.6 * k as f64 / steps as f64;
         sim.advance_to(t_dimless / scale).expect("runs");
-        curve.push((t_dimless, sim.observe().expect("observes").front_m / a));
+        curve.push((t_dimless, front(&sim) / a));
     }
     let mut data = read_front("dambreak_front_position/martin_moyce1952_n2_2_a1.125in.csv");
     data.extend(read_front(

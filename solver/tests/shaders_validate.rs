@@ -207,7 +207,9 @@ fn rust_mirrors_have_the_wgsl_layout() {
         dt_min_bits,
         status,
         last_dt,
-        step_base
+        step_base,
+        dt_prev,
+        dt_taken
     );
 
     let observe = ALL

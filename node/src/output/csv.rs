@@ -50,7 +50,8 @@ impl<W: Write> GaugeCsv<W> {
             obs.time_s,
             obs.steps,
             obs.dt_s as f32,
-            obs.front_m as f32,
+            obs.front_m
+                .map_or_else(String::new, |x| (x as f32).to_string()),
             obs.max_speed_m_per_s as f32,
             obs.max_density_error as f32,
             obs.cfl as f32,
@@ -118,7 +119,7 @@ mod tests {
                 name: "toe".into(),
                 pressure_pa: Some(1900.5),
             }],
-            front_m: 0.1,
+            front_m: Some(0.1),
             max_speed_m_per_s: 0.5,
             max_density_error: 0.002,
             fluid_particles: 3200,

@@ -61,12 +61,16 @@ pub struct StepState {
     pub status: u32,
     pub last_dt: f32,
     pub step_base: u32,
+    pub dt_prev: f32,
+    pub dt_taken: f32,
+    pub pad: [u32; 2],
 }
 
 impl StepState {
     /// The state at the start of a chunk that ends `t_target` seconds later, `step_base` steps
-    /// (modulo the Verlet Euler period) after the start of the run.
-    pub fn chunk(t_target: f32, last_dt: f32, step_base: u32) -> StepState {
+    /// (modulo the Verlet Euler period) after the start of the run, the last step having been
+    /// `dt_taken` long and its CFL step `last_dt`.
+    pub fn chunk(t_target: f32, last_dt: f32, dt_taken: f32, step_base: u32) -> StepState {
         StepState {
             dt: 0.0,
             t_rel: 0.0,
@@ -76,6 +80,9 @@ impl StepState {
             status: 0,
             last_dt,
             step_base,
+            dt_prev: 0.0,
+            dt_taken,
+            pad: [0; 2],
         }
     }
 }

@@ -1,7 +1,7 @@
 //! WGSL sources, embedded in the binary, and their composition.
 //!
-//! A stage file (`shaders/stages/*.wgsl`) names the import-only modules it needs in its
-//! wrapper's `IMPORTS`; composition prepends them in the order given. Nothing is substituted
+//! A stage (`shaders/stages/*.wgsl`) lists the import-only modules it needs in its
+//! `StageSpec::imports` (`stages.rs`); composition prepends them in the order given. Nothing is substituted
 //! inside any source, so each composed module is the plain concatenation of files on disk.
 
 macro_rules! embed {

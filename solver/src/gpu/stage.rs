@@ -143,6 +143,18 @@ impl Stage {
         })
     }
 
+    /// Records one dispatch of entry point `entry` over `items` invocations, in workgroups of
+    /// the stage's declared size.
+    pub fn record_items(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        entry: usize,
+        bind: &wgpu::BindGroup,
+        items: u32,
+    ) {
+        self.record(pass, entry, bind, groups(items, self.spec.workgroup));
+    }
+
     /// Records one dispatch of entry point `entry` (index into `entry_points`) over `groups`.
     pub fn record(
         &self,

@@ -1,4 +1,5 @@
-//! Symplectic position-Verlet time integration in the DualSPHysics form (Leimkuhler et al. 1996;
+//! Time integration as in DualSPHysics: `verlet` (Verlet 1967, one force pass a step), and
+//! symplectic position-Verlet time integration in the DualSPHysics form (Leimkuhler et al. 1996;
 //! Crespo et al. 2015, DualSPHysics): a predictor half step, a force pass at the half step, and a
 //! corrector full step. Density uses the exact update `rho_new = rho_n (2 - eps) / (2 + eps)`,
 //! `eps = -(d rho/dt / rho)_half dt`, which is exact for a constant d rho/dt.
@@ -103,17 +104,20 @@ pub fn corrector(
 pub type VerletState = (Vec<[f32; 4]>, Vec<[f32; 4]>, Vec<[f32; 4]>);
 
 /// One Verlet step (Verlet 1967, as in DualSPHysics): from the state at n, the velocity and
-/// density at n - 1 and the forces at n,
-/// `x' = x + dt v + dt^2/2 a`, `v' = v_prev + 2 dt a`, `rho' = rho_prev + 2 dt drho`;
+/// density at n - 1 (`dt_prev` before) and the forces at n,
+/// `x' = x + dt v + dt^2/2 a`, `v' = v_prev + (dt_prev + dt) a`,
+/// `rho' = rho_prev + (dt_prev + dt) drho`;
 /// with `euler`, `v' = v + dt a`, `rho' = rho + dt drho` instead (the periodic Euler step that
 /// keeps the leapfrog's two sequences together). Walls keep position and velocity, and
 /// `rho >= rho0`.
 ///
 /// Returns `(positions, vel_rho, vel_rho_prev)` at n + 1. Panics if the slices differ in
 /// length or a phase index is outside `phases` (caller bugs).
+#[allow(clippy::too_many_arguments)]
 pub fn verlet(
     phases: &[Phase],
     dt: f32,
+    dt_prev: f32,
     euler: bool,
     pos: &[[f32; 4]],
     vel_rho: &[[f32; 4]],
@@ -127,7 +131,7 @@ pub fn verlet(
     let mut vel_new = Vec::with_capacity(pos.len());
     for (((x, v), vp), f) in pos.iter().zip(vel_rho).zip(vel_rho_prev).zip(forces) {
         let phase = &phases[phase_index(x)];
-        let (from, span) = if euler { (v, dt) } else { (vp, 2.0 * dt) };
+        let (from, span) = if euler { (v, dt) } else { (vp, dt_prev + dt) };
         let rho = from[3] + span * f[3];
         if phase.mobile {
             let half_dt2 = 0.5 * dt * dt;
@@ -182,6 +186,7 @@ mod tests {
             c0: 20.0,
             gravity: [0.0, 0.0, -9.81],
             delta: 0.1,
+            hydrostatic_diffusion: true,
             viscosity: Viscosity::Artificial { alpha: 0.01 },
             cfl: 0.2,
             phases: phases(),
@@ -277,7 +282,7 @@ mod tests {
         let steps = 200;
         for k in 0..steps {
             // Euler every 40 steps, as DualSPHysics does by default.
-            let (p, v, vp) = verlet(&phases, dt, k % 40 == 0, &pos, &vel, &prev, &forces);
+            let (p, v, vp) = verlet(&phases, dt, dt, k % 40 == 0, &pos, &vel, &prev, &forces);
             pos = p;
             vel = v;
             prev = vp;

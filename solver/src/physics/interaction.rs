@@ -112,8 +112,12 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
             if params.delta > 0.0 && phase_j.mobile && pj == pi {
                 let rho0 = phase_i.rho0;
                 let dz = pos[i][vertical] - pos[j][vertical];
-                let base = 1.0 + rho0 * g * dz / stiffness[pi];
-                let rho_h = rho0 * (base.powf(1.0 / 7.0) - 1.0);
+                let rho_h = if params.hydrostatic_diffusion {
+                    let base = 1.0 + rho0 * g * dz / stiffness[pi];
+                    rho0 * (base.powf(1.0 / 7.0) - 1.0)
+                } else {
+                    0.0
+                };
                 let psi = 2.0 * (rho_j - rho_i - rho_h) * (-r2 * f) / (r2 + eta2);
                 drho += params.delta * h * c0 * psi * (m_j / rho_j);
             }
@@ -205,6 +209,7 @@ mod tests {
             c0,
             gravity: [0.0, -9.81, 0.0],
             delta: 0.0,
+            hydrostatic_diffusion: true,
             viscosity: Viscosity::Artificial { alpha: 0.0 },
             cfl: 0.2,
             phases: vec![water(mass), wall(mass)],

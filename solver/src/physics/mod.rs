@@ -1,5 +1,5 @@
 //! CPU reference physics of the weakly compressible SPH solver (Zubeldia et al. 2018, Eqs. 4, 8-10,
-//! with DualSPHysics' symplectic integrator and DBC walls of Crespo et al. 2007).
+//! with DualSPHysics' symplectic and Verlet integrators and DBC walls of Crespo et al. 2007).
 //!
 //! Everything here is plain f32 arithmetic over slices, written to be read as a spec: it is the
 //! oracle the GPU shaders are tested against, so it follows the same formulas (not necessarily the
@@ -53,6 +53,9 @@ pub struct Params {
     pub c0: f32,
     /// Gravity acceleration, m/s2, `[x, y, z]` (z = 0 in 2-D, where y is vertical).
     pub gravity: [f32; 3],
+    /// Subtract the hydrostatic density difference in the diffusion term (Fourtakas et al.
+    /// 2019); without it the term is Molteni & Colagrossi 2009.
+    pub hydrostatic_diffusion: bool,
     /// Density diffusion coefficient delta (dimensionless, typically 0.1); 0 turns it off.
     pub delta: f32,
     /// Viscosity model.

@@ -37,6 +37,7 @@ mod tests {
             c0: 20.0,
             gravity: [0.0, -9.81, 0.0],
             delta: 0.1,
+            hydrostatic_diffusion: true,
             viscosity: Viscosity::Laminar,
             cfl: 0.2,
             phases,

@@ -53,6 +53,7 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
         c0: p.c0,
         gravity: [p.gravity[0], p.gravity[1], p.gravity[2]],
         delta: p.delta_h_c0 / (p.h * p.c0),
+        hydrostatic_diffusion: p.diffusion_mode == flume_solver::gpu::params::DIFFUSION_FOURTAKAS,
         viscosity: if p.viscosity_mode == VISCOSITY_ARTIFICIAL {
             Viscosity::Artificial { alpha: p.alpha }
         } else {
