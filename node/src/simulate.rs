@@ -1,7 +1,10 @@
 //! `flume-twin simulate`: an offline run of a case, interval by interval.
 
 use crate::cli::SimulateArgs;
-use crate::output::{csv::GaugeCsv, vtk};
+use crate::output::{
+    csv::{GaugeCsv, ProfileCsv},
+    vtk,
+};
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::{Case, GpuContext, Observations, Simulation, SolverError};
@@ -122,6 +125,8 @@ struct Recorder {
     dir: PathBuf,
     csv_path: PathBuf,
     csv: GaugeCsv<BufWriter<File>>,
+    /// profile.csv, when the case asks for a layer profile.
+    profile: Option<(PathBuf, ProfileCsv<BufWriter<File>>)>,
     snapshot_every: Option<u64>,
 }
 
@@ -137,10 +142,23 @@ impl Recorder {
             .with_context(|| format!("cannot create {}", csv_path.display()))?;
         let csv = GaugeCsv::new(BufWriter::new(file), &gauges, &probes)
             .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        let profile = match &obs.profile {
+            None => None,
+            Some(_) => {
+                let path = dir.join("profile.csv");
+                let phases: Vec<String> = case.phases.iter().map(|p| p.name.clone()).collect();
+                let file = File::create(&path)
+                    .with_context(|| format!("cannot create {}", path.display()))?;
+                let csv = ProfileCsv::new(BufWriter::new(file), &phases)
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                Some((path, csv))
+            }
+        };
         Ok(Recorder {
             dir: dir.to_path_buf(),
             csv_path,
             csv,
+            profile,
             snapshot_every,
         })
     }
@@ -153,6 +171,10 @@ impl Recorder {
         self.csv
             .row(&obs)
             .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
+        if let Some((path, csv)) = &mut self.profile {
+            csv.rows(&obs)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
         if self.snapshot_every.is_some_and(|n| k.is_multiple_of(n)) {
             self.snapshot(sim, &format!("particles_{k:04}.vtk"))?;
         }

@@ -201,6 +201,19 @@ fn short_run_writes_gauges_and_snapshots() {
         "last row at t = {last_time}"
     );
 
+    // The case's 13 profile columns, per output row, with the surface of the column at the
+    // dam (x = 0.05 m, inside the column 0.2 m high) near its height.
+    let profile = fs::read_to_string(out_dir.join("profile.csv")).unwrap();
+    let mut lines = profile.lines();
+    assert_eq!(lines.next().unwrap(), "time_s,x_m,surface_m,water_top_m");
+    let profile_rows: Vec<&str> = lines.collect();
+    assert_eq!(profile_rows.len(), 13 * rows.len(), "{profile}");
+    let at_dam: f64 = profile_rows[1].split(',').nth(2).unwrap().parse().unwrap();
+    assert!(
+        (at_dam - 0.2).abs() < 0.01,
+        "surface at x = 0.05 m: {at_dam}"
+    );
+
     let particles: usize = stdout
         .lines()
         .find_map(|l| l.strip_prefix("particles: "))

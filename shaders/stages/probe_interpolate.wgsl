@@ -1,11 +1,13 @@
-// Kernel sums at probe points: the "fullness" sum_j V_j W (free-surface gauges, as DualSPHysics'
-// SWL gauge) and sum_j V_j p_j W (Shepard-corrected pressure). Reference: physics/probe.rs.
+// Kernel sums at probe points: sum_j V_j p_j W (Shepard-corrected pressure) and the "fullness"
+// sum_j V_j W of each fluid phase (phases 1-3), whose total places the free surface (as
+// DualSPHysics' SWL gauge) and each of which places the top of its own layer.
+// Reference: physics/probe.rs.
 
 @group(0) @binding(1) var positions: texture_2d<f32>;
 @group(0) @binding(2) var vel_rho: texture_2d<f32>;
 @group(0) @binding(3) var<storage, read> cell_starts: array<u32>;
 @group(0) @binding(4) var<storage, read> probe_points: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read_write> probe_sums: array<vec2<f32>>;
+@group(0) @binding(5) var<storage, read_write> probe_sums: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn probe_interpolate(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -15,8 +17,8 @@ fn probe_interpolate(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = probe_points[k].xyz;
     let four_h2 = 4.0 * params.h * params.h;
-    var fullness = 0.0;
-    var pressure = 0.0;
+    // x: pressure sum; y, z, w: fullness of phases 1, 2, 3.
+    var sums = vec4<f32>(0.0);
     let cell = cell_coords(x);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
@@ -30,9 +32,9 @@ fn probe_interpolate(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let rho_j = textureLoad(vel_rho, texel(j), 0).w;
             let vw = params.phases[phase_j].mass / rho_j * kernel_w(sqrt(r2));
-            fullness += vw;
-            pressure += vw * tait_pressure(rho_j, phase_j);
+            sums.x += vw * tait_pressure(rho_j, phase_j);
+            sums[phase_j] += vw;
         }
     }
-    probe_sums[k] = vec2<f32>(fullness, pressure);
+    probe_sums[k] = sums;
 }

@@ -190,6 +190,39 @@ pub struct ObservationConfig {
     /// Points at which pressure is interpolated (Shepard-corrected kernel sum).
     #[serde(default)]
     pub pressure_probes: Vec<ProbeConfig>,
+    /// Columns along x at which the free surface and the top of each phase's layer are
+    /// reported (the bed profile when one phase is a sediment bed).
+    #[serde(default)]
+    pub profile: Option<ProfileConfig>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileConfig {
+    /// First and last column, m, and the number of columns (bins) between them.
+    pub x_min_m: f64,
+    pub x_max_m: f64,
+    pub columns: u32,
+    /// The cross-flume position of the columns in 3-D, m (ignored in 2-D).
+    #[serde(default)]
+    pub y_m: f64,
+}
+
+impl ProfileConfig {
+    /// Horizontal positions of the columns: x evenly from x_min to x_max (and y in 3-D).
+    pub fn positions(&self, dim: usize) -> Vec<Vec<f64>> {
+        let n = self.columns.max(1);
+        (0..n)
+            .map(|k| {
+                let x = if n == 1 {
+                    self.x_min_m
+                } else {
+                    self.x_min_m + (self.x_max_m - self.x_min_m) * f64::from(k) / f64::from(n - 1)
+                };
+                if dim == 3 { vec![x, self.y_m] } else { vec![x] }
+            })
+            .collect()
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -460,6 +493,32 @@ impl Case {
                         "must lie inside the domain".into(),
                     );
                 }
+            }
+        }
+        if let Some(p) = &self.observations.profile {
+            let inside = |x: f64| (self.domain.min_m[0]..=self.domain.max_m[0]).contains(&x);
+            if !(p.x_min_m.is_finite()
+                && p.x_max_m.is_finite()
+                && inside(p.x_min_m)
+                && inside(p.x_max_m))
+                || p.x_max_m < p.x_min_m
+            {
+                return err(
+                    "observations.profile",
+                    "x_min_m <= x_max_m, both inside the domain".into(),
+                );
+            }
+            if !(1..=10_000).contains(&p.columns) {
+                return err(
+                    "observations.profile.columns",
+                    format!("must be 1..=10000, got {}", p.columns),
+                );
+            }
+            if d == 3 && !(self.domain.min_m[1]..=self.domain.max_m[1]).contains(&p.y_m) {
+                return err(
+                    "observations.profile.y_m",
+                    "must lie inside the domain".into(),
+                );
             }
         }
         for (i, p) in self.observations.pressure_probes.iter().enumerate() {

@@ -16,5 +16,5 @@ pub mod stages;
 
 pub use config::{Case, ConfigError};
 pub use gpu::{GpuContext, GpuError};
-pub use observe::Observations;
+pub use observe::{Observations, ProfileColumn};
 pub use simulation::{Health, Recovery, Simulation, SolverError};

@@ -31,6 +31,8 @@ pub struct Observations {
     pub dt_s: f64,
     pub gauges: Vec<GaugeReading>,
     pub probes: Vec<ProbeReading>,
+    /// The layers along the flume (`observations.profile` of the case), upstream first.
+    pub profile: Vec<ProfileColumn>,
     /// Largest x of any fluid particle, m (the surge front of a dam break); None without fluid.
     pub front_m: Option<f64>,
     pub max_speed_m_per_s: f64,
@@ -43,32 +45,87 @@ pub struct Observations {
     pub cfl: f64,
 }
 
-/// The sample points of every gauge column and probe, in the order the GPU evaluates them.
-pub struct ProbeLayout {
-    pub points: Vec<[f32; 4]>,
-    gauges: Vec<(String, Vec<f64>)>,
-    probes: Vec<String>,
+/// The top of each fluid phase's layer and the free surface along one vertical line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileColumn {
+    /// Horizontal position of the column, m.
+    pub x_m: f64,
+    /// Free surface (all fluid phases together), m; None when the column is dry.
+    pub surface_m: Option<f64>,
+    /// Top of each phase's layer, in the case's phase order, m; None where the phase is absent.
+    pub layer_tops_m: Vec<Option<f64>>,
 }
 
-impl ProbeLayout {
-    pub fn new(case: &Case, h: f64) -> ProbeLayout {
+/// A vertical line of sample points from the tank floor to above its top, dp / 2 apart.
+struct Column {
+    position: Vec<f64>,
+    heights: Vec<f64>,
+}
+
+impl Column {
+    fn new(case: &Case, h: f64, position: Vec<f64>) -> Column {
         let d = case.dim();
         let step = 0.5 * case.numerics.dp_m;
         let bottom = case.domain.min_m[d - 1];
         let top = case.domain.max_m[d - 1] + 2.0 * h;
         let n = ((top - bottom) / step).ceil() as usize + 1;
-        let mut points = Vec::new();
-        let mut gauges = Vec::new();
-        for g in &case.observations.gauges {
-            let heights: Vec<f64> = (0..n).map(|k| bottom + k as f64 * step).collect();
-            for &z in &heights {
-                let mut p = [0.0f32; 4];
-                p[..d - 1]
-                    .copy_from_slice(&g.position_m.iter().map(|v| *v as f32).collect::<Vec<_>>());
-                p[d - 1] = z as f32;
-                points.push(p);
+        Column {
+            position,
+            heights: (0..n).map(|k| bottom + k as f64 * step).collect(),
+        }
+    }
+
+    fn push_points(&self, points: &mut Vec<[f32; 4]>) {
+        let d = self.position.len() + 1;
+        for &z in &self.heights {
+            let mut p = [0.0f32; 4];
+            for (pk, v) in p.iter_mut().zip(&self.position) {
+                *pk = *v as f32;
             }
-            gauges.push((g.name.clone(), heights));
+            p[d - 1] = z as f32;
+            points.push(p);
+        }
+    }
+
+    /// Where `fullness` (one value per height) drops through one half, top-most.
+    fn level(&self, sums: &[[f32; 4]], fullness: impl Fn(&[f32; 4]) -> f32) -> Option<f64> {
+        let values: Vec<f32> = sums.iter().map(fullness).collect();
+        free_surface_level(&self.heights, &values, SURFACE_FULLNESS)
+    }
+}
+
+/// The sample points of every gauge column, profile column and probe, in the order the GPU
+/// evaluates them. Each point's sums are the pressure sum and the fullness of phases 1-3.
+pub struct ProbeLayout {
+    pub points: Vec<[f32; 4]>,
+    gauges: Vec<(String, Column)>,
+    profile: Vec<Column>,
+    probes: Vec<String>,
+    fluid_phases: usize,
+}
+
+fn total_fullness(s: &[f32; 4]) -> f32 {
+    s[1] + s[2] + s[3]
+}
+
+impl ProbeLayout {
+    pub fn new(case: &Case, h: f64) -> ProbeLayout {
+        let mut points = Vec::new();
+        let gauges: Vec<(String, Column)> = case
+            .observations
+            .gauges
+            .iter()
+            .map(|g| (g.name.clone(), Column::new(case, h, g.position_m.clone())))
+            .collect();
+        let profile: Vec<Column> = case
+            .observations
+            .profile
+            .iter()
+            .flat_map(|p| p.positions(case.dim()))
+            .map(|x| Column::new(case, h, x))
+            .collect();
+        for c in gauges.iter().map(|g| &g.1).chain(&profile) {
+            c.push_points(&mut points);
         }
         let mut probes = Vec::new();
         for p in &case.observations.pressure_probes {
@@ -82,7 +139,9 @@ impl ProbeLayout {
         ProbeLayout {
             points,
             gauges,
+            profile,
             probes,
+            fluid_phases: case.phases.len(),
         }
     }
 
@@ -91,31 +150,47 @@ impl ProbeLayout {
         time_s: f64,
         steps: u64,
         dt_s: f64,
-        sums: &[[f32; 2]],
+        sums: &[[f32; 4]],
         ext: &Extremes,
     ) -> Observations {
-        let mut offset = 0;
-        let mut gauges = Vec::new();
-        for (name, heights) in &self.gauges {
-            let fullness: Vec<f32> = sums[offset..offset + heights.len()]
-                .iter()
-                .map(|s| s[0])
-                .collect();
-            offset += heights.len();
-            gauges.push(GaugeReading {
+        let mut rest = sums;
+        let mut take = |n: usize| {
+            let (head, tail) = rest.split_at(n.min(rest.len()));
+            rest = tail;
+            head
+        };
+        let gauges = self
+            .gauges
+            .iter()
+            .map(|(name, column)| GaugeReading {
                 name: name.clone(),
-                level_m: free_surface_level(heights, &fullness, SURFACE_FULLNESS),
-            });
-        }
+                level_m: column.level(take(column.heights.len()), total_fullness),
+            })
+            .collect();
+        let profile = self
+            .profile
+            .iter()
+            .map(|column| {
+                let s = take(column.heights.len());
+                ProfileColumn {
+                    x_m: column.position[0],
+                    surface_m: column.level(s, total_fullness),
+                    layer_tops_m: (1..=self.fluid_phases)
+                        .map(|k| column.level(s, |v| v[k]))
+                        .collect(),
+                }
+            })
+            .collect();
         let probes = self
             .probes
             .iter()
-            .zip(&sums[offset..])
+            .zip(take(self.probes.len()))
             .map(|(name, s)| ProbeReading {
                 name: name.clone(),
                 pressure_pa: ProbeSums {
-                    fullness: s[0],
-                    pressure_sum: s[1],
+                    fullness: total_fullness(s),
+                    pressure_sum: s[0],
+                    phase_fullness: [0.0, s[1], s[2], s[3]],
                 }
                 .pressure()
                 .map(f64::from),
@@ -127,6 +202,7 @@ impl ProbeLayout {
             dt_s,
             gauges,
             probes,
+            profile,
             front_m: (ext.fluid_count > 0).then(|| f64::from(from_order_key(ext.front_key))),
             max_speed_m_per_s: f64::from(f32::from_bits(ext.max_speed_bits)),
             max_density_error: f64::from(f32::from_bits(ext.max_rho_err_bits)),

@@ -209,7 +209,7 @@ impl GpuBuffers {
             scan_levels,
             state: storage(gpu, "step state", std::mem::size_of::<StepState>() as u64),
             probe_points: storage(gpu, "probe points", u64::from(n_probes.max(1)) * VEC4_BYTES),
-            probe_sums: storage(gpu, "probe sums", u64::from(n_probes.max(1)) * 8),
+            probe_sums: storage(gpu, "probe sums", u64::from(n_probes.max(1)) * VEC4_BYTES),
             extremes: storage(gpu, "extremes", 16),
             a,
         }

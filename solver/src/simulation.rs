@@ -526,12 +526,12 @@ impl Simulation {
             &[
                 (
                     &self.buffers.probe_sums,
-                    self.probes.points.len() as u64 * 8,
+                    self.probes.points.len() as u64 * 16,
                 ),
                 (&self.buffers.extremes, 16),
             ],
         )?;
-        let sums: Vec<[f32; 2]> = cast_vec(&raw[0]);
+        let sums: Vec<[f32; 4]> = cast_vec(&raw[0]);
         let ext: Extremes = bytemuck::pod_read_unaligned(&raw[1]);
         let mut obs =
             self.probes

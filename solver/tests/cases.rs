@@ -79,6 +79,33 @@ fn two_phases_at_rest_keep_the_layered_hydrostatic_pressure() {
             obs.max_speed_m_per_s
         );
         let level = obs.gauges[0].level_m.expect("gauge in water");
+        // The profile finds the same surface and the top of the dense layer, within dp / 2.
+        assert_eq!(obs.profile.len(), 4);
+        let half_dp = 0.5 * c.numerics.dp_m;
+        for col in &obs.profile {
+            let surface = col.surface_m.expect("wet column");
+            let dense_top = col.layer_tops_m[1].expect("dense layer present");
+            let water_top = col.layer_tops_m[0].expect("water present");
+            eprintln!(
+                "two layers t={t:.2} x={:.3}: surface {surface:.4} m, dense top {dense_top:.4} m",
+                col.x_m
+            );
+            assert!(
+                (surface - level).abs() <= half_dp,
+                "x={}: surface {surface} vs gauge {level}",
+                col.x_m
+            );
+            assert!(
+                (water_top - surface).abs() <= half_dp,
+                "x={}: water top {water_top}",
+                col.x_m
+            );
+            assert!(
+                (dense_top - interface).abs() <= half_dp,
+                "x={}: dense top {dense_top} vs {interface}",
+                col.x_m
+            );
+        }
         for (probe, cfg) in obs.probes.iter().zip(&c.observations.pressure_probes) {
             let z = cfg.position_m[1];
             let expected = if z < interface {

@@ -78,6 +78,38 @@ impl<W: Write> GaugeCsv<W> {
     }
 }
 
+/// The layer profile, one row per column per output interval (long format, so that a
+/// spreadsheet or pandas can pivot it): time, x, free surface, then the top of each phase.
+pub struct ProfileCsv<W: Write> {
+    w: W,
+}
+
+impl<W: Write> ProfileCsv<W> {
+    pub fn new(mut w: W, phases: &[String]) -> io::Result<Self> {
+        let header: Vec<String> = ["time_s", "x_m", "surface_m"]
+            .iter()
+            .map(|c| c.to_string())
+            .chain(phases.iter().map(|p| field(&format!("{p}_top_m"))))
+            .collect();
+        writeln!(w, "{}", header.join(","))?;
+        w.flush()?;
+        Ok(ProfileCsv { w })
+    }
+
+    pub fn rows(&mut self, obs: &Observations) -> io::Result<()> {
+        for col in &obs.profile {
+            let mut line = format!("{},{},", obs.time_s, col.x_m as f32);
+            let cells = std::iter::once(col.surface_m).chain(col.layer_tops_m.iter().copied());
+            let text: Vec<String> = cells
+                .map(|v| v.map_or_else(String::new, |v| (v as f32).to_string()))
+                .collect();
+            line.push_str(&text.join(","));
+            writeln!(self.w, "{line}")?;
+        }
+        self.w.flush()
+    }
+}
+
 /// Quotes a header cell when a gauge name would otherwise break the CSV (RFC 4180).
 fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
@@ -120,6 +152,7 @@ mod tests {
                 pressure_pa: Some(1900.5),
             }],
             front_m: Some(0.1),
+            profile: vec![],
             max_speed_m_per_s: 0.5,
             max_density_error: 0.002,
             fluid_particles: 3200,
@@ -132,6 +165,43 @@ mod tests {
             text,
             "time_s,step,dt_s,front_m,max_speed_m_per_s,max_density_error,cfl,recoveries,near_wall_m,\"a,b_m\",toe_pa\n\
              0.005,42,0.000125,0.1,0.5,0.002,0.1,1,0.19,,1900.5\n"
+        );
+    }
+
+    #[test]
+    fn profile_rows_are_long_format_with_empty_cells_for_absent_layers() {
+        let mut buf = Vec::new();
+        let mut csv =
+            ProfileCsv::new(&mut buf, &["water".to_string(), "sand".to_string()]).unwrap();
+        let obs = Observations {
+            time_s: 0.5,
+            steps: 1,
+            dt_s: 1e-4,
+            gauges: vec![],
+            probes: vec![],
+            profile: vec![
+                flume_solver::ProfileColumn {
+                    x_m: 0.25,
+                    surface_m: Some(0.1),
+                    layer_tops_m: vec![Some(0.1), Some(0.04)],
+                },
+                flume_solver::ProfileColumn {
+                    x_m: 0.5,
+                    surface_m: None,
+                    layer_tops_m: vec![None, Some(0.03)],
+                },
+            ],
+            front_m: None,
+            max_speed_m_per_s: 0.0,
+            max_density_error: 0.0,
+            fluid_particles: 0,
+            recoveries: 0,
+            cfl: 0.2,
+        };
+        csv.rows(&obs).unwrap();
+        assert_eq!(
+            String::from_utf8(buf).unwrap(),
+            "time_s,x_m,surface_m,water_top_m,sand_top_m\n0.5,0.25,0.1,0.1,0.04\n0.5,0.5,,,0.03\n"
         );
     }
 }

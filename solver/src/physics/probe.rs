@@ -15,6 +15,9 @@ pub struct ProbeSums {
     pub fullness: f32,
     /// `sum_j V_j W p_j`, Pa.
     pub pressure_sum: f32,
+    /// The fullness of each phase alone, by phase index (walls, index 0, stay 0): where a layer
+    /// of one phase ends, its own fullness drops through one half.
+    pub phase_fullness: [f32; 4],
 }
 
 impl ProbeSums {
@@ -55,6 +58,7 @@ pub fn probe(
         let rho = v[3];
         let vw = phase.mass / rho * w(r2.sqrt(), h, params.dim);
         sums.fullness += vw;
+        sums.phase_fullness[phase_index(x)] += vw;
         sums.pressure_sum += vw * pressure(rho, phase.rho0, tait_b(params.c0, phase.rho0));
     }
     sums
