@@ -245,7 +245,7 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
     ]);
     t.row([
         "blow-ups recovered".to_string(),
-        format!("{} (CFL now {})", last.recoveries, last.cfl),
+        format!("{} (CFL now {:.3})", last.recoveries, last.cfl),
     ]);
     println!();
     print!("{t}");

@@ -69,6 +69,10 @@ impl std::fmt::Display for Health {
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
 pub const MAX_RECOVERIES_PER_CHUNK: u32 = 4;
+/// Clean `advance_to` calls after which a CFL number lowered by a recovery is doubled again,
+/// up to the case's own: a twin that runs for hours should not keep the smallest step of its
+/// worst moment.
+pub const CFL_RESTORE_AFTER_CHUNKS: u32 = 50;
 /// Largest CFL number `set_cfl` accepts. Above about 1 the scheme is unstable: values up to
 /// this are accepted so that an operator (or a test) can see the recovery bring it back down.
 pub const MAX_CFL: f64 = 5.0;
@@ -106,6 +110,9 @@ pub struct Simulation {
     dt_taken: f32,
     initial_particles: Particles,
     recoveries: Vec<Recovery>,
+    /// The CFL number to come back to after a recovery lowered it (the case's, or as set).
+    cfl_target: f32,
+    clean_chunks: u32,
 }
 
 /// Grid of cells of size 2h / CELL_DIVISIONS covering the tank, its walls and a margin above it.
@@ -206,6 +213,8 @@ impl Simulation {
             dt_taken: 0.0,
             initial_particles: particles,
             recoveries: Vec::new(),
+            cfl_target: params.cfl,
+            clean_chunks: 0,
         })
     }
 
@@ -246,7 +255,8 @@ impl Simulation {
     /// The state at the start is kept on the GPU; if the chunk blows up (NaN, runaway density,
     /// collapsing step), the state is restored and the chunk retried with half the CFL number,
     /// up to `MAX_RECOVERIES_PER_CHUNK` times, each logged and listed in `recoveries`. The
-    /// smaller CFL number stays in force afterwards. Only then is the blow-up an error.
+    /// smaller CFL number stays in force until `CFL_RESTORE_AFTER_CHUNKS` clean calls, then
+    /// doubles back towards the case's. Past the retries the blow-up is an error.
     pub fn advance_to(&mut self, target_s: f64) -> Result<(), SolverError> {
         if target_s < self.time_s {
             return Err(SolverError::TimeGoesBack {
@@ -265,12 +275,17 @@ impl Simulation {
         let mut tries = 0;
         loop {
             match self.run_chunk(target_s) {
+                Ok(()) => {
+                    self.restore_cfl_when_calm();
+                    return Ok(());
+                }
                 Err(SolverError::BlowUp {
                     time_s,
                     step,
                     health,
                 }) if tries < MAX_RECOVERIES_PER_CHUNK => {
                     tries += 1;
+                    self.clean_chunks = 0;
                     self.copy_state(&self.buffers.snapshot, &self.buffers.a);
                     (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
                     self.params.cfl *= 0.5;
@@ -291,8 +306,26 @@ impl Simulation {
                         cfl: f64::from(self.params.cfl),
                     });
                 }
-                other => return other,
+                Err(e) => return Err(e),
             }
+        }
+    }
+
+    fn restore_cfl_when_calm(&mut self) {
+        if self.params.cfl >= self.cfl_target {
+            return;
+        }
+        self.clean_chunks += 1;
+        if self.clean_chunks >= CFL_RESTORE_AFTER_CHUNKS {
+            self.clean_chunks = 0;
+            self.params.cfl = (2.0 * self.params.cfl).min(self.cfl_target);
+            self.gpu
+                .queue
+                .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+            log::info!(
+                "{CFL_RESTORE_AFTER_CHUNKS} calm chunks: CFL back up to {}",
+                self.params.cfl
+            );
         }
     }
 
@@ -315,6 +348,7 @@ impl Simulation {
             });
         }
         self.params.cfl = cfl as f32;
+        self.cfl_target = cfl as f32;
         self.gpu
             .queue
             .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));

@@ -358,9 +358,9 @@ fn a_blow_up_is_caught_rolled_back_and_retried_with_a_smaller_cfl() {
     assert!(sim.recoveries().is_empty());
     sim.set_cfl(5.0).expect("accepted for the test");
     sim.advance_to(0.03).expect("recovers");
-    let rec = sim.recoveries();
+    let rec = sim.recoveries().to_vec();
     assert!(!rec.is_empty(), "CFL 5 did not blow up");
-    for r in rec {
+    for r in &rec {
         eprintln!("recovered: {r:?}");
         assert_eq!(r.restored_to_s, 0.01);
         assert!(!r.health.is_ok());
@@ -382,6 +382,19 @@ fn a_blow_up_is_caught_rolled_back_and_retried_with_a_smaller_cfl() {
     let p = sim.read_particles().expect("readback");
     assert_in_tank(&c, &p);
     assert_mass_conserved(&sim, &p);
+    // After enough calm chunks the CFL number doubles back towards the one asked for.
+    let lowered = sim.cfl();
+    let n = flume_solver::simulation::CFL_RESTORE_AFTER_CHUNKS;
+    for k in 1..=n {
+        sim.advance_to(0.03 + f64::from(k) * 2e-5)
+            .expect("calm chunk");
+    }
+    assert_eq!(sim.recoveries().len(), rec.len(), "a calm chunk blew up");
+    assert_eq!(
+        sim.cfl(),
+        2.0 * lowered,
+        "not restored after {n} calm chunks"
+    );
     assert!(
         sim.set_cfl(-1.0).is_err() && sim.set_cfl(f64::NAN).is_err() && sim.set_cfl(50.0).is_err()
     );
