@@ -330,3 +330,60 @@ fn two_verlet_steps_match_the_cpu_steps() {
         integrate::verlet(&params.phases, dt2, dt, false, &p1, &v1, &prev1, &f1.forces);
     assert_step_close(&after, &p2, &v2, &[&f0.forces, &f1.forces], dt, 2.0);
 }
+
+/// The per-phase fullness of the probe stage, through the profile it yields: on a perturbed
+/// two-layer state, each column's free surface and layer tops from the GPU equal those the
+/// CPU oracle's sums give on the same sample heights (the floor to dp / 2 above the tank top
+/// plus 2h, as `observe::Column` samples), to within 1e-5 m of interpolation rounding.
+#[test]
+fn probe_interpolate_phase_fullness_matches_the_cpu() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case("tests/cases/two_layer_2d.yaml");
+    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
+    let particles = common::perturbed(&sim0, 0.3, 23);
+    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    let obs = sim.observe().expect("observe");
+    let h = sim.derived().h;
+    let step = 0.5 * c.numerics.dp_m;
+    let top = c.domain.max_m[1] + 2.0 * h;
+    let n = ((top - c.domain.min_m[1]) / step).ceil() as usize + 1;
+    let heights: Vec<f64> = (0..n)
+        .map(|k| c.domain.min_m[1] + k as f64 * step)
+        .collect();
+    assert!(!obs.profile.is_empty());
+    for col in &obs.profile {
+        let sums: Vec<probe::ProbeSums> = heights
+            .iter()
+            .map(|z| {
+                probe::probe(
+                    &params,
+                    [col.x_m as f32, *z as f32, 0.0],
+                    &particles.positions,
+                    &particles.vel_rho,
+                )
+            })
+            .collect();
+        let level = |f: &dyn Fn(&probe::ProbeSums) -> f32| {
+            let v: Vec<f32> = sums.iter().map(f).collect();
+            probe::free_surface_level(&heights, &v, 0.5)
+        };
+        let close = |gpu: Option<f64>, cpu: Option<f64>, what: &str| match (gpu, cpu) {
+            (Some(g), Some(c)) => assert!(
+                (g - c).abs() < 1e-5,
+                "x={} {what}: gpu {g} cpu {c}",
+                col.x_m
+            ),
+            (g, c) => assert_eq!(g, c, "x={} {what}", col.x_m),
+        };
+        close(col.surface_m, level(&|s| s.fullness), "surface");
+        for (k, gpu_top) in col.layer_tops_m.iter().enumerate() {
+            close(
+                *gpu_top,
+                level(&|s| s.phase_fullness[k + 1]),
+                &format!("top of phase {}", k + 1),
+            );
+        }
+    }
+}
