@@ -30,6 +30,18 @@ pub enum SolverError {
     },
     #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
     TimeGoesBack { target_s: f64, now_s: f64 },
+    #[error(
+        "c0 = {c0_m_per_s:.3} m/s is too low for fluid {fluid_height_m} m high: at rest its density \
+         is already {:.1} % off rest density (the bound is 10 %); use c0 above {c0_needed_m_per_s:.2} m/s \
+         (coefsound 10 or more is usual)",
+        100.0 * density_error
+    )]
+    SoundSpeedTooLow {
+        c0_m_per_s: f64,
+        fluid_height_m: f64,
+        density_error: f64,
+        c0_needed_m_per_s: f64,
+    },
     #[error("parameter `{name}` refused: {reason}")]
     InvalidParameter { name: &'static str, reason: String },
 }
@@ -154,6 +166,26 @@ impl Simulation {
         }
         GpuBuffers::check_limits(&gpu, count, n_cells)?;
         let particles = case::generate(case, &derived);
+        // A sound speed too low for the fluid's height starts outside the weakly compressible
+        // range: say so now, not as a blow-up at the first step.
+        let worst = (0..particles.len())
+            .filter(|&i| particles.phase(i) != WALL_PHASE)
+            .map(|i| {
+                let rho0 = derived.phases[particles.phase(i) as usize].rho0;
+                (f64::from(particles.vel_rho[i][3]) / rho0 - 1.0).abs()
+            })
+            .fold(0.0, f64::max);
+        if worst > f64::from(RHO_RATIO_MAX) {
+            return Err(SolverError::SoundSpeedTooLow {
+                c0_m_per_s: derived.c0,
+                fluid_height_m: derived.fluid_height,
+                density_error: worst,
+                // (1 + 7 g H / c0^2)^(1/7) - 1 stays below the bound for c0 above this.
+                c0_needed_m_per_s: (7.0 * case.gravity_magnitude() * derived.fluid_height
+                    / ((1.0 + f64::from(RHO_RATIO_MAX)).powi(7) - 1.0))
+                    .sqrt(),
+            });
+        }
         Self::from_particles(gpu, case, particles)
     }
 

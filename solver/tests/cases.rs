@@ -400,6 +400,28 @@ fn a_blow_up_is_caught_rolled_back_and_retried_with_a_smaller_cfl() {
     );
 }
 
+/// A sound speed so low that the fluid at rest is already outside the weakly compressible
+/// range is refused when the simulation is built, with the c0 that would do.
+#[test]
+fn a_sound_speed_too_low_for_the_column_is_refused_up_front() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("../launch_configs/dambreak_water.yaml");
+    c.numerics.sound_speed = flume_solver::config::SoundSpeed {
+        c0_m_per_s: Some(0.2),
+        coefsound: None,
+    };
+    let err = match Simulation::new(gpu, &c) {
+        Ok(_) => panic!("accepted c0 = 0.2 m/s for a 0.2 m column"),
+        Err(e) => e.to_string(),
+    };
+    eprintln!("{err}");
+    assert!(
+        err.contains("too low") && err.contains("use c0 above"),
+        "{err}"
+    );
+}
+
 /// A case that no time step can save (a sound speed far below the flow's speed) fails with
 /// the blow-up error after the retries, instead of returning garbage.
 #[test]
@@ -407,13 +429,13 @@ fn an_unrecoverable_blow_up_is_an_error_that_says_so() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let mut c = case("../launch_configs/dambreak_water.yaml");
-    c.numerics.dp_m = 0.005;
+    c.numerics.dp_m = 0.01;
     c.numerics.sound_speed = flume_solver::config::SoundSpeed {
-        c0_m_per_s: Some(0.2),
+        c0_m_per_s: Some(4.0),
         coefsound: None,
     };
     let mut sim = Simulation::new(gpu, &c).expect("case builds");
-    let err = sim.advance_to(0.05).expect_err("cannot survive");
+    let err = sim.advance_to(0.3).expect_err("cannot survive");
     let text = err.to_string();
     eprintln!("{text}");
     assert!(
