@@ -9,11 +9,14 @@ use crate::gpu::stage::{Stage, groups};
 use crate::gpu::{GpuContext, GpuError};
 use crate::stages::{self, PREFIX_SUM_BLOCK};
 
-/// Cells per kernel support 2h along each axis (see `shaders/common/neighbours.wgsl`). With 2
-/// the neighbour loops visit about a third fewer candidates, but on lavapipe the four times
-/// larger cell list cost more than that saved (measured 4.8e5 against 5.6e5 particle-steps/s
-/// on the DualSPHysics case), so cells are 2h wide.
-pub const CELL_DIVISIONS: u32 = 1;
+/// Cells per kernel support 2h along each axis (see `shaders/common/neighbours.wgsl`).
+/// Smaller cells mean fewer candidates outside the support but a larger cell list. Measured
+/// on lavapipe: in 2-D, cells of h (2) lost to cells of 2h (4.8e5 against 5.6e5
+/// particle-steps/s on the DualSPHysics case); in 3-D they won (1.36e5 against 1.03e5 on the
+/// 3-D dam break), the stencil's 27 cells of 2h holding about 2,000 candidates.
+pub fn cell_divisions(dim: u32) -> u32 {
+    if dim == 2 { 1 } else { 2 }
+}
 
 pub struct SphPipeline {
     grid_clear: Stage,
@@ -37,11 +40,12 @@ pub struct SphPipeline {
 impl SphPipeline {
     pub fn new(gpu: &GpuContext, dim: u32, verlet: bool) -> SphPipeline {
         let d = &gpu.device;
-        let width = f64::from(2 * CELL_DIVISIONS + 1);
+        let divisions = cell_divisions(dim);
+        let width = f64::from(2 * divisions + 1);
         let rows = if dim == 2 { width } else { width * width };
         let stencil = [
             ("STENCIL_ROWS", rows),
-            ("CELL_DIVISIONS", f64::from(CELL_DIVISIONS)),
+            ("CELL_DIVISIONS", f64::from(divisions)),
         ];
         SphPipeline {
             grid_clear: Stage::new(d, &stages::GRID_CLEAR, &[]),

@@ -127,10 +127,10 @@ pub struct Simulation {
     clean_chunks: u32,
 }
 
-/// Grid of cells of size 2h / CELL_DIVISIONS covering the tank, its walls and a margin above it.
+/// Grid of cells of size 2h / cell_divisions covering the tank, its walls and a margin above it.
 fn grid_for(case: &Case, h: f64) -> Result<([u32; 4], [f32; 4]), SolverError> {
     let d = case.dim();
-    let cell = 2.0 * h / f64::from(crate::pipeline::CELL_DIVISIONS);
+    let cell = 2.0 * h / f64::from(crate::pipeline::cell_divisions(case.dimension));
     let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
     let mut dims = [1u32; 4];
     let mut origin = [0.0f32; 4];
