@@ -127,10 +127,14 @@ pub struct Simulation {
     clean_chunks: u32,
 }
 
+fn divisions_of(case: &Case, h: f64) -> u32 {
+    crate::pipeline::cell_divisions(case.dimension, h / case.numerics.dp_m)
+}
+
 /// Grid of cells of size 2h / cell_divisions covering the tank, its walls and a margin above it.
 fn grid_for(case: &Case, h: f64) -> Result<([u32; 4], [f32; 4]), SolverError> {
     let d = case.dim();
-    let cell = 2.0 * h / f64::from(crate::pipeline::cell_divisions(case.dimension));
+    let cell = 2.0 * h / f64::from(divisions_of(case, h));
     let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
     let mut dims = [1u32; 4];
     let mut origin = [0.0f32; 4];
@@ -228,7 +232,8 @@ impl Simulation {
             bytemuck::cast_slice(&probes.points),
         );
         let verlet = matches!(case.numerics.integrator, Integrator::Verlet { .. });
-        let pipeline = SphPipeline::new(&gpu, case.dimension, verlet);
+        let pipeline =
+            SphPipeline::new(&gpu, case.dimension, divisions_of(case, derived.h), verlet);
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
         Ok(Simulation {
             gpu,
