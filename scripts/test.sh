@@ -4,4 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
+# An independent reader of our VTK snapshots, for the interop check in node/tests/cli.rs.
+if ! python3 -c "import meshio" >/dev/null 2>&1; then
+  python3 -m pip install --quiet --disable-pip-version-check meshio
+fi
 cargo test --release --workspace "$@"

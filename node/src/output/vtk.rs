@@ -1,5 +1,6 @@
-//! Particle snapshots as legacy VTK 3.0 POLYDATA, binary: the format ParaView, VisIt and
-//! DualSPHysics' PartVTK all read without plugins.
+//! Particle snapshots as legacy VTK 3.0 UNSTRUCTURED_GRID of vertex cells, binary: ParaView
+//! and VisIt open it without plugins, and so do Python readers such as meshio (which reads no
+//! POLYDATA; the tests read our snapshots with it).
 //!
 //! Legacy binary VTK is big-endian whatever the machine, and the points are always 3-D
 //! (z = 0 in a 2-D case) because readers have no 2-D point type.
@@ -20,7 +21,7 @@ pub fn write_particles<W: Write>(mut w: W, title: &str, particles: &Particles) -
         .collect();
     write!(
         w,
-        "# vtk DataFile Version 3.0\n{title}\nBINARY\nDATASET POLYDATA\n"
+        "# vtk DataFile Version 3.0\n{title}\nBINARY\nDATASET UNSTRUCTURED_GRID\n"
     )?;
 
     writeln!(w, "POINTS {n} float")?;
@@ -30,9 +31,14 @@ pub fn write_particles<W: Write>(mut w: W, title: &str, particles: &Particles) -
     writeln!(w)?;
 
     // Legacy 3.0 cell lists: each cell is its point count followed by its point indices.
-    writeln!(w, "VERTICES {n} {}", 2 * n)?;
+    writeln!(w, "CELLS {n} {}", 2 * n)?;
     for i in 0..count {
         put_i32s(&mut w, &[1, i])?;
+    }
+    writeln!(w)?;
+    writeln!(w, "CELL_TYPES {n}")?;
+    for _ in 0..count {
+        put_i32s(&mut w, &[VTK_VERTEX])?;
     }
     writeln!(w)?;
 
@@ -60,6 +66,9 @@ pub fn write_particles<W: Write>(mut w: W, title: &str, particles: &Particles) -
     writeln!(w)?;
     Ok(())
 }
+
+/// VTK's cell type number of a single point.
+const VTK_VERTEX: i32 = 1;
 
 fn put_f32s<W: Write>(w: &mut W, values: &[f32]) -> io::Result<()> {
     for v in values {
@@ -127,7 +136,7 @@ mod tests {
         assert_eq!(take_line(&mut b), "# vtk DataFile Version 3.0");
         assert_eq!(take_line(&mut b), "test t=0.5 s");
         assert_eq!(take_line(&mut b), "BINARY");
-        assert_eq!(take_line(&mut b), "DATASET POLYDATA");
+        assert_eq!(take_line(&mut b), "DATASET UNSTRUCTURED_GRID");
 
         assert_eq!(take_line(&mut b), "POINTS 2 float");
         // 1.0f32 big-endian is 3f 80 00 00: the first bytes pin the byte order.
@@ -135,8 +144,11 @@ mod tests {
         assert_eq!(be_f32s(take(&mut b, 24)), [1.0, 2.0, 0.0, 0.5, -0.25, 0.0]);
         assert_eq!(take_line(&mut b), "");
 
-        assert_eq!(take_line(&mut b), "VERTICES 2 4");
+        assert_eq!(take_line(&mut b), "CELLS 2 4");
         assert_eq!(be_i32s(take(&mut b, 16)), [1, 0, 1, 1]);
+        assert_eq!(take_line(&mut b), "");
+        assert_eq!(take_line(&mut b), "CELL_TYPES 2");
+        assert_eq!(be_i32s(take(&mut b, 8)), [1, 1]);
         assert_eq!(take_line(&mut b), "");
 
         assert_eq!(take_line(&mut b), "POINT_DATA 2");
