@@ -30,14 +30,6 @@ fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     let eps = -(f.w / textureLoad(vel_rho_half, texel(i), 0).w) * dt;
     let rho = vr.w * (2.0 - eps) / (2.0 + eps);
     ids_out[i] = ids_n[i];
-    if (ph.mobile > 0.5) {
-        let v = vr.xyz + dt * f.xyz;
-        let x = p.xyz + dt * 0.5 * (vr.xyz + v);
-        positions_out[i] = vec4<f32>(x, p.w);
-        vel_rho_out[i] = vec4<f32>(v, rho);
-        check_health(x, v, rho, ph.rho0);
-    } else {
-        positions_out[i] = p;
-        vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));
-    }
+    let v = vr.xyz + dt * f.xyz;
+    store_state(i, p, vr, p.xyz + dt * 0.5 * (vr.xyz + v), v, rho, ph);
 }

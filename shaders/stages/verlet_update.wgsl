@@ -42,14 +42,6 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rho = base.w + span * f.w;
     ids_out[i] = ids_n[i];
     vel_rho_prev_out[i] = vr;
-    if (ph.mobile > 0.5) {
-        let v = base.xyz + span * f.xyz;
-        let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
-        positions_out[i] = vec4<f32>(x, p.w);
-        vel_rho_out[i] = vec4<f32>(v, rho);
-        check_health(x, v, rho, ph.rho0);
-    } else {
-        positions_out[i] = p;
-        vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));
-    }
+    let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
+    store_state(i, p, vr, x, base.xyz + span * f.xyz, rho, ph);
 }

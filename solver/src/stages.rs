@@ -20,11 +20,16 @@ const WITH_NEIGHBOURS: &[&str] = &[
     "common/step_state.wgsl",
 ];
 const WITH_STATE: &[&str] = &["common/params.wgsl", "common/step_state.wgsl"];
-const INTEGRATE: &[&str] = &[
+const HALF_STEP: &[&str] = &[
     "common/params.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
-    "common/health.wgsl",
+];
+const FULL_STEP: &[&str] = &[
+    "common/params.wgsl",
+    "common/particle_texture.wgsl",
+    "common/step_state.wgsl",
+    "common/store_state.wgsl",
 ];
 
 pub const GRID_CLEAR: StageSpec = StageSpec {
@@ -146,7 +151,7 @@ pub const DT_UPDATE: StageSpec = StageSpec {
 pub const SYMPLECTIC_PREDICTOR: StageSpec = StageSpec {
     name: "symplectic_predictor",
     shader: "stages/symplectic_predictor.wgsl",
-    imports: INTEGRATE,
+    imports: HALF_STEP,
     bindings: &[
         ("params", 0, Uniform),
         ("state", 1, ReadWrite),
@@ -163,7 +168,7 @@ pub const SYMPLECTIC_PREDICTOR: StageSpec = StageSpec {
 pub const SYMPLECTIC_CORRECTOR: StageSpec = StageSpec {
     name: "symplectic_corrector",
     shader: "stages/symplectic_corrector.wgsl",
-    imports: INTEGRATE,
+    imports: FULL_STEP,
     bindings: &[
         ("params", 0, Uniform),
         ("state", 1, ReadWrite),
@@ -183,7 +188,7 @@ pub const SYMPLECTIC_CORRECTOR: StageSpec = StageSpec {
 pub const VERLET_UPDATE: StageSpec = StageSpec {
     name: "verlet_update",
     shader: "stages/verlet_update.wgsl",
-    imports: INTEGRATE,
+    imports: FULL_STEP,
     bindings: &[
         ("params", 0, Uniform),
         ("state", 1, ReadWrite),

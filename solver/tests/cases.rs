@@ -400,17 +400,24 @@ fn a_blow_up_is_caught_rolled_back_and_retried_with_a_smaller_cfl() {
     );
 }
 
+/// The dam-break case at spacing `dp_m` with the sound speed set to `c0_m_per_s`.
+fn dambreak_with_c0(c0_m_per_s: f64, dp_m: f64) -> Case {
+    let mut c = case("../launch_configs/dambreak_water.yaml");
+    c.numerics.dp_m = dp_m;
+    c.numerics.sound_speed = flume_solver::config::SoundSpeed {
+        c0_m_per_s: Some(c0_m_per_s),
+        coefsound: None,
+    };
+    c
+}
+
 /// A sound speed so low that the fluid at rest is already outside the weakly compressible
 /// range is refused when the simulation is built, with the c0 that would do.
 #[test]
 fn a_sound_speed_too_low_for_the_column_is_refused_up_front() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
-    let mut c = case("../launch_configs/dambreak_water.yaml");
-    c.numerics.sound_speed = flume_solver::config::SoundSpeed {
-        c0_m_per_s: Some(0.2),
-        coefsound: None,
-    };
+    let c = dambreak_with_c0(0.2, 0.0025);
     let err = match Simulation::new(gpu, &c) {
         Ok(_) => panic!("accepted c0 = 0.2 m/s for a 0.2 m column"),
         Err(e) => e.to_string(),
@@ -428,12 +435,7 @@ fn a_sound_speed_too_low_for_the_column_is_refused_up_front() {
 fn an_unrecoverable_blow_up_is_an_error_that_says_so() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
-    let mut c = case("../launch_configs/dambreak_water.yaml");
-    c.numerics.dp_m = 0.01;
-    c.numerics.sound_speed = flume_solver::config::SoundSpeed {
-        c0_m_per_s: Some(4.0),
-        coefsound: None,
-    };
+    let c = dambreak_with_c0(4.0, 0.01);
     let mut sim = Simulation::new(gpu, &c).expect("case builds");
     let err = sim.advance_to(0.3).expect_err("cannot survive");
     let text = err.to_string();
@@ -447,4 +449,42 @@ fn an_unrecoverable_blow_up_is_an_error_that_says_so() {
         sim.recoveries().len(),
         flume_solver::simulation::MAX_RECOVERIES_PER_CHUNK as usize
     );
+}
+
+/// A domain whose neighbour grid would need more cells than 32-bit indices hold is refused
+/// before anything is generated or allocated (the product used to wrap in u32).
+#[test]
+fn a_grid_too_large_for_32_bit_cell_indices_is_refused() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let mut c = case("tests/cases/hydrostatic_2d.yaml");
+    c.domain.max_m = vec![2000.0, 2000.0];
+    let err = match Simulation::new(gpu, &c) {
+        Ok(_) => panic!("a grid of billions of cells was accepted"),
+        Err(e) => e,
+    };
+    assert!(
+        matches!(err, flume_solver::SolverError::TooManyCells(n) if n > u64::from(u32::MAX)),
+        "{err}"
+    );
+    assert!(err.to_string().contains("coarser dp"), "{err}");
+}
+
+/// A target time that is not a finite number is refused, and the simulation stays usable.
+#[test]
+fn a_non_finite_target_time_is_refused() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = dambreak_with_c0(28.0, 0.01);
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    for t in [f64::NAN, f64::INFINITY] {
+        let err = sim.advance_to(t).expect_err("refused");
+        assert!(err.to_string().contains("finite"), "{err}");
+    }
+    sim.advance_to(0.001).expect("still runs");
+    assert_eq!(sim.time_s(), 0.001);
+    assert!(matches!(
+        sim.advance_to(0.0005),
+        Err(flume_solver::SolverError::TimeGoesBack { .. })
+    ));
 }

@@ -6,9 +6,8 @@
 
 mod common;
 
+use flume_solver::Case;
 use flume_solver::physics::{integrate, interaction, probe};
-use flume_solver::{Case, Simulation};
-use std::sync::Arc;
 
 fn case(name: &str) -> Case {
     Case::from_path(&common::case_path(name)).expect("test case parses")
@@ -49,10 +48,7 @@ fn grid_stages_match_a_cpu_counting_sort_exactly() {
         sparse,
     ];
     for (c, seed) in cases.iter().zip(1..) {
-        let sim0 = Simulation::new(Arc::clone(&gpu), c).expect("case builds");
-        let particles = common::perturbed(&sim0, 0.0, seed);
-        let sim =
-            Simulation::from_particles(Arc::clone(&gpu), c, particles.clone()).expect("builds");
+        let (sim, particles, _) = common::perturbed_sim(&gpu, c, 0.0, seed);
         let p = sim.params();
         let (starts, sorted_ids) = sim.cell_list().expect("cell list");
         // CPU: the same f32 cell formula, then a stable counting sort by (cell, id).
@@ -99,10 +95,7 @@ fn check_forces(name: &str, seed: u64) {
 fn check_forces_of(c: Case, name: &str, seed: u64) {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
-    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
-    let particles = common::perturbed(&sim0, 0.3, seed);
-    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, seed);
     let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
     let cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
     // Pairwise pressure terms reach ~1e3 m/s2 and cancel to ~g: 1e-4 of the largest value
@@ -153,10 +146,7 @@ fn forces_wcsph_laminar_matches_the_cpu_interaction() {
     c.phases[0].viscosity_pa_s = 0.5;
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
-    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
-    let particles = common::perturbed(&sim0, 0.3, 9);
-    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, 9);
     let (gpu_forces, _) = sim.compute_forces().expect("forces");
     let cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
     assert_close("laminar acceleration", &gpu_forces, &cpu.forces, 2, 1e-4);
@@ -167,11 +157,7 @@ fn one_symplectic_step_matches_the_cpu_step() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = case("tests/cases/hydrostatic_2d.yaml");
-    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
-    let particles = common::perturbed(&sim0, 0.3, 11);
-    let mut sim =
-        Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (mut sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, 11);
     // A target below the stable step: the GPU takes exactly one step of that length.
     let dt = 2.0e-5f32;
     sim.advance_to(f64::from(dt)).expect("one step");
@@ -249,10 +235,7 @@ fn probe_interpolate_and_observe_reduce_match_the_cpu() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = case("tests/cases/hydrostatic_2d.yaml");
-    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
-    let particles = common::perturbed(&sim0, 0.3, 13);
-    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, 13);
     let obs = sim.observe().expect("observe");
     for (reading, cfg) in obs.probes.iter().zip(&c.observations.pressure_probes) {
         let x = &cfg.position_m;
@@ -300,11 +283,7 @@ fn two_verlet_steps_match_the_cpu_steps() {
     c.numerics.integrator = flume_solver::config::Integrator::Verlet {
         euler_every_steps: 40,
     };
-    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
-    let particles = common::perturbed(&sim0, 0.3, 17);
-    let mut sim =
-        Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (mut sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, 17);
     let dt = 2.0e-5f32;
     sim.advance_to(f64::from(dt)).expect("step 1");
     // A second step of another length: the leapfrog spans both steps.
@@ -340,10 +319,7 @@ fn probe_interpolate_phase_fullness_matches_the_cpu() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = case("tests/cases/two_layer_2d.yaml");
-    let sim0 = Simulation::new(Arc::clone(&gpu), &c).expect("case builds");
-    let particles = common::perturbed(&sim0, 0.3, 23);
-    let sim = Simulation::from_particles(Arc::clone(&gpu), &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, 23);
     let obs = sim.observe().expect("observe");
     let h = sim.derived().h;
     let step = 0.5 * c.numerics.dp_m;

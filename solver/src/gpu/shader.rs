@@ -19,7 +19,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "common/neighbours.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
-    "common/health.wgsl",
+    "common/store_state.wgsl",
     "stages/grid_clear.wgsl",
     "stages/grid_count.wgsl",
     "stages/prefix_sum.wgsl",

@@ -109,3 +109,23 @@ pub fn perturbed(
     }
     p
 }
+
+/// A simulation of `case` started from its lattice perturbed as `perturbed` does, with that
+/// state and the CPU oracle's parameters: the starting point of every GPU-vs-CPU test.
+pub fn perturbed_sim(
+    gpu: &Arc<GpuContext>,
+    case: &flume_solver::Case,
+    speed: f32,
+    seed: u64,
+) -> (
+    flume_solver::Simulation,
+    flume_solver::case::Particles,
+    flume_solver::physics::Params,
+) {
+    let lattice = flume_solver::Simulation::new(Arc::clone(gpu), case).expect("case builds");
+    let particles = perturbed(&lattice, speed, seed);
+    let sim = flume_solver::Simulation::from_particles(Arc::clone(gpu), case, particles.clone())
+        .expect("perturbed state builds");
+    let params = reference_params(&sim);
+    (sim, particles, params)
+}
