@@ -8,10 +8,34 @@ struct Phase {
     mobile: f32,    // 1 for fluid, 0 for DBC wall particles
 }
 
+// The sediment phase (Zubeldia et al. 2018); phase == 0 when the case has none.
+struct Sediment {
+    phase: u32,              // index of the sediment in `phases`
+    water_phase: u32,        // index of the water it lies in
+    shields_only: u32,       // 1: Shields only, sediment not eroded or suspended is held fixed
+    pad: u32,
+    rho_s: f32,              // saturated density, kg/m3
+    rho_w: f32,              // water density, kg/m3
+    d50: f32,                // median grain diameter, m
+    nu_w: f32,               // water kinematic viscosity, m2/s
+    mu_w: f32,               // water dynamic viscosity, Pa s (Vand, Eq. 33)
+    mu_s: f32,               // HBP mu_s, Pa s
+    hbp_m: f32,              // Papanastasiou m, s
+    hbp_n: f32,              // power-law index n
+    ks: f32,                 // equivalent roughness, m
+    surface_mass: f32,       // m_f times the sediment particle mass (Eq. 26)
+    dp_alpha: f32,           // Drucker-Prager alpha (Eq. 29)
+    dp_kappa: f32,           // Drucker-Prager kappa_c, Pa (Eq. 29)
+    phi: f32,                // internal friction angle, rad
+    mu_max: f32,             // cap on the apparent viscosity, Pa s
+    submerged_weight: f32,   // (rho_s - rho_w) |g|, N/m3 (Eq. 16 without theta and d)
+    pad1: f32,
+}
+
 struct SimParams {
     n_particles: u32,
     n_cells: u32,
-    viscosity_mode: u32,     // 0 artificial (Monaghan 1992), 1 laminar (Morris 1997)
+    viscosity_mode: u32,     // 0 artificial (Monaghan 1992), 1 laminar (Morris 1997), 2 multiphase stress
     diffusion_mode: u32,     // 0 none, 1 Molteni-Colagrossi 2009, 2 Fourtakas 2019
     grid_dims: vec4<u32>,    // cells along x, y, z (z = 1 in 2-D)
     grid_origin: vec4<f32>,  // xyz of the grid corner, w = 1 / cell size
@@ -34,6 +58,7 @@ struct SimParams {
     pad2: u32,
     phases: array<Phase, 4>,
     tait_b: vec4<f32>,       // c0^2 rho0 / 7 per phase
+    sediment: Sediment,
 }
 
 @group(0) @binding(0) var<uniform> params: SimParams;

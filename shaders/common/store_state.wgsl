@@ -1,5 +1,8 @@
 // The end of an integration step, shared by both integrators: the importing stage declares
-// `state`, `positions_out` and `vel_rho_out`.
+// `state`, `regions`, `positions_out` and `vel_rho_out`.
+
+// Mirrors REGION_HELD of shaders/common/sediment.wgsl.
+const REGION_HELD_BIT: u32 = 256u;
 
 // Raises health flags for a particle's new state.
 fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
@@ -18,9 +21,14 @@ fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
 
 // Writes particle i's new position x, velocity v and density rho (p, vr: its old state).
 // Walls (DBC) keep their position and velocity, and their density never drops below rho0 so
-// that they never pull fluid in.
+// that they never pull fluid in. Held sediment (the rheology pass's REGION_HELD bit in
+// `regions`, which the importing stage declares) keeps its position at rest.
 fn store_state(i: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase) {
-    if (ph.mobile > 0.5) {
+    if (ph.mobile > 0.5 && (regions[i] & REGION_HELD_BIT) != 0u) {
+        positions_out[i] = p;
+        vel_rho_out[i] = vec4<f32>(0.0, 0.0, 0.0, rho);
+        check_health(p.xyz, vec3<f32>(0.0), rho, ph.rho0);
+    } else if (ph.mobile > 0.5) {
         positions_out[i] = vec4<f32>(x, p.w);
         vel_rho_out[i] = vec4<f32>(v, rho);
         check_health(x, v, rho, ph.rho0);

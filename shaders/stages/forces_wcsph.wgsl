@@ -1,7 +1,8 @@
 // Weakly compressible SPH interaction (Eqs. 9-10 with the Tait pressure of Eq. 4):
 // continuity with density diffusion (Molteni & Colagrossi 2009; hydrostatic correction of
 // Fourtakas et al. 2019), pressure gradient, artificial (Monaghan 1992) or laminar (Morris et
-// al. 1997) viscosity, gravity; DBC walls (Crespo et al. 2007) only gather density.
+// al. 1997) viscosity or the divergence of the viscous stress of the rheology pass (multiphase,
+// Eq. 10 with sigma = -p I + tau), gravity; DBC walls (Crespo et al. 2007) only gather density.
 // Also the per-particle stable step of the variable time step, min-reduced into `state`.
 // Reference: solver/src/physics/interaction.rs.
 
@@ -10,6 +11,18 @@
 @group(0) @binding(3) var<storage, read> cell_starts: array<u32>;
 @group(0) @binding(4) var<storage, read_write> forces: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> state: StepState;
+@group(0) @binding(6) var stress_a: texture_2d<f32>;
+@group(0) @binding(7) var stress_b: texture_2d<f32>;
+
+const VISCOSITY_MULTIPHASE: u32 = 2u;
+
+// A particle's viscous stress over rho^2 from the rheology pass's (xx, xy, xz, yy) and
+// (yz, zz, mu, region) texels.
+fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
+    let a = textureLoad(stress_a, texel(i), 0);
+    let b = textureLoad(stress_b, texel(i), 0);
+    return mat3x3<f32>(a.xyz, vec3<f32>(a.y, a.w, b.x), vec3<f32>(a.z, b.x, b.y)) * (1.0 / (rho * rho));
+}
 
 // The corrector's half-step forces do not set the step: only the predictor's do (DualSPHysics).
 override REDUCE_DT: bool = true;
@@ -37,6 +50,11 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rho0_i = params.phases[phase_i].rho0;
     let b_i = params.tait_b[phase_i];
     let mu_i = params.phases[phase_i].mu;
+    let multiphase = params.viscosity_mode == VISCOSITY_MULTIPHASE;
+    var tau_i = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    if (multiphase && mobile_i) {
+        tau_i = stress_over_rho2(i, rho_i);
+    }
 
     var acc = vec3<f32>(0.0);
     var drho = 0.0;
@@ -87,6 +105,12 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                     coef -= m_j * pi_ij;
                 }
                 acc += coef * f * dx;
+            } else if (multiphase) {
+                var tau = tau_i;
+                if (mobile_j) {
+                    tau += stress_over_rho2(j, rho_j);
+                }
+                acc += coef * f * dx + (m_j * f) * (tau * dx);
             } else {
                 let mu_j = params.phases[phase_j].mu;
                 acc += coef * f * dx + (m_j * (mu_i + mu_j) * (r2 * f) / (rho_i * rho_j * (r2 + params.eta2))) * dv;
@@ -101,6 +125,13 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
             dt_i = sqrt(h / a);
         }
         dt_i = min(dt_i, h / (params.c0 + visc_max));
+        if (multiphase) {
+            // The explicit viscous limit with the particle's own apparent viscosity.
+            let mu_app = textureLoad(stress_b, texel(i), 0).z;
+            if (mu_app > 0.0) {
+                dt_i = min(dt_i, 0.125 * h * h * rho_i / mu_app);
+            }
+        }
     } else {
         acc = vec3<f32>(0.0);
     }

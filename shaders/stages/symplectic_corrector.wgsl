@@ -13,6 +13,7 @@
 @group(0) @binding(7) var<storage, read_write> positions_out: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> vel_rho_out: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
+@group(0) @binding(10) var<storage, read> regions: array<u32>;
 
 @compute @workgroup_size(128)
 fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -1,7 +1,7 @@
 // Symplectic position-Verlet integration as in DualSPHysics, first half step:
 // x(n+1/2) = x(n) + dt/2 v(n), v(n+1/2) = v(n) + dt/2 a(n), rho(n+1/2) = rho(n) + dt/2 drho(n).
 // Walls (DBC) keep position and velocity; their density never drops below rho0 so that they
-// never pull fluid in. Reference: solver/src/physics/integrate.rs.
+// never pull fluid in; held sediment stays at rest. Reference: solver/src/physics/integrate.rs.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
 @group(0) @binding(2) var<storage, read> forces: array<vec4<f32>>;
@@ -9,6 +9,10 @@
 @group(0) @binding(4) var vel_rho_n: texture_2d<f32>;
 @group(0) @binding(5) var positions_half: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(6) var vel_rho_half: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(7) var<storage, read> regions: array<u32>;
+
+// Mirrors REGION_HELD of shaders/common/sediment.wgsl.
+const REGION_HELD_BIT: u32 = 256u;
 
 @compute @workgroup_size(128)
 fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -23,7 +27,10 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = forces[i];
     let phase = bitcast<u32>(p.w);
     let rho = vr.w + half_dt * f.w;
-    if (params.phases[phase].mobile > 0.5) {
+    if (params.phases[phase].mobile > 0.5 && (regions[i] & REGION_HELD_BIT) != 0u) {
+        textureStore(positions_half, texel(i), p);
+        textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, rho));
+    } else if (params.phases[phase].mobile > 0.5) {
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * vr.xyz, p.w));
         textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz + half_dt * f.xyz, rho));
     } else {

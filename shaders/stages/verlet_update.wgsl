@@ -18,6 +18,7 @@
 @group(0) @binding(8) var<storage, read_write> vel_rho_out: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
 @group(0) @binding(10) var<storage, read_write> vel_rho_prev_out: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read> regions: array<u32>;
 
 @compute @workgroup_size(128)
 fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -80,9 +80,60 @@ pub struct PhaseConfig {
     pub name: String,
     /// Rest density of the phase's equation of state, kg/m3.
     pub rho0_kg_per_m3: f64,
-    /// Dynamic viscosity, Pa s (used by laminar viscosity).
+    /// Dynamic viscosity, Pa s: the laminar viscosity, the water's mu_w of Eq. 11 or the
+    /// sediment's mu_s of Eq. 15.
     #[serde(default = "water_viscosity")]
     pub viscosity_pa_s: f64,
+    /// Makes this phase an erodible, saturated sediment bed (Zubeldia et al. 2018); absent for
+    /// water. Needs `numerics.viscosity.method: multiphase`.
+    #[serde(default)]
+    pub sediment: Option<SedimentConfig>,
+}
+
+/// Material of a sediment phase; the phase's `rho0_kg_per_m3` is its saturated density rho_s
+/// and its `viscosity_pa_s` the mu_s of the HBP law (Eq. 15).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SedimentConfig {
+    /// Median grain diameter d50, m (Eqs. 16-17).
+    pub d50_m: f64,
+    /// Internal friction angle phi, degrees (Eqs. 22-23, 29).
+    pub friction_angle_deg: f64,
+    /// Cohesion c, Pa (Eq. 29).
+    #[serde(default)]
+    pub cohesion_pa: f64,
+    /// Papanastasiou exponent m of Eq. 15, s (0 with n = 1: Newtonian).
+    pub hbp_m_s: f64,
+    /// Power-law index n of Eq. 15.
+    pub hbp_n: f64,
+    /// Equivalent roughness over grain size, ks / d50 (Eq. 21).
+    pub ks_over_d50: f64,
+    /// Fraction m_f of a full kernel's sediment mass below which a particle with water in its
+    /// support is at the bed surface (Eq. 26).
+    #[serde(default = "default_surface_mass_fraction")]
+    pub surface_mass_fraction: f64,
+    /// Which yield criteria apply.
+    pub criterion: YieldCriterion,
+    /// Cap on the apparent viscosity, Pa s. Without it, mu_max = 0.125 h rho_s c0: the
+    /// viscosity whose explicit diffusion limit `0.125 h^2 rho / mu` equals the acoustic step
+    /// `h / c0`, so the sediment never shortens the time step below what the water needs.
+    #[serde(default)]
+    pub max_viscosity_pa_s: Option<f64>,
+}
+
+/// Yield criteria of a sediment phase (Zubeldia et al. 2018, Section 2.5).
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum YieldCriterion {
+    /// Drucker-Prager below the surface, Shields at the surface (Section 2.5.4, Figure 2).
+    DruckerPragerShields,
+    /// Shields at the surface only; sediment that is not eroded or suspended is held fixed
+    /// (the paper's flushing and flume cases).
+    ShieldsOnly,
+}
+
+fn default_surface_mass_fraction() -> f64 {
+    0.9
 }
 
 fn water_viscosity() -> f64 {
@@ -170,6 +221,9 @@ pub enum Viscosity {
     Artificial { alpha: f64 },
     /// Laminar viscosity (Morris et al. 1997) with each phase's `viscosity_pa_s`.
     Laminar,
+    /// The viscous stress tau = 2 mu eps of Eqs. 10-11 and 14 from each particle's strain rate,
+    /// mu the water's viscosity or, for sediment, the apparent viscosity of its region.
+    Multiphase,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -306,6 +360,75 @@ impl Case {
         self.phases.iter().position(|p| p.name == name)
     }
 
+    /// The sediment phase and the water phase it lies in, as indices into `phases`.
+    pub fn sediment_phases(&self) -> Option<(usize, usize)> {
+        let sediment = self.phases.iter().position(|p| p.sediment.is_some())?;
+        let water = self.phases.iter().position(|p| p.sediment.is_none())?;
+        Some((sediment, water))
+    }
+
+    fn validate_sediment(&self, i: usize, s: &SedimentConfig) -> Result<(), (String, String)> {
+        let field = |name: &str| format!("phases[{i}].sediment.{name}");
+        let err = |name: &str, reason: &str| Err((field(name), reason.to_string()));
+        if self.phases.iter().filter(|p| p.sediment.is_some()).count() > 1 {
+            return Err((
+                format!("phases[{i}].sediment"),
+                "only one sediment phase is supported".into(),
+            ));
+        }
+        let water: Vec<&PhaseConfig> =
+            self.phases.iter().filter(|p| p.sediment.is_none()).collect();
+        if water.len() != 1 {
+            return Err((
+                "phases".into(),
+                "a sediment needs exactly one water phase (a phase without `sediment`)".into(),
+            ));
+        }
+        if self.phases[i].rho0_kg_per_m3 <= water[0].rho0_kg_per_m3 {
+            return Err((
+                format!("phases[{i}].rho0_kg_per_m3"),
+                "a sediment must be denser than the water".into(),
+            ));
+        }
+        if !matches!(self.numerics.viscosity, Viscosity::Multiphase) {
+            return Err((
+                "numerics.viscosity.method".into(),
+                "a sediment phase needs `multiphase`".into(),
+            ));
+        }
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !positive(s.d50_m) {
+            return err("d50_m", "must be positive");
+        }
+        if !(s.friction_angle_deg.is_finite()
+            && s.friction_angle_deg > 0.0
+            && s.friction_angle_deg < 90.0)
+        {
+            return err("friction_angle_deg", "must be between 0 and 90 degrees");
+        }
+        if !(s.cohesion_pa.is_finite() && s.cohesion_pa >= 0.0) {
+            return err("cohesion_pa", "must be >= 0");
+        }
+        if !(s.hbp_m_s.is_finite() && s.hbp_m_s >= 0.0) {
+            return err("hbp_m_s", "must be >= 0");
+        }
+        if !positive(s.hbp_n) {
+            return err("hbp_n", "must be positive");
+        }
+        if !positive(s.ks_over_d50) {
+            return err("ks_over_d50", "must be positive");
+        }
+        if !(positive(s.surface_mass_fraction) && s.surface_mass_fraction <= 1.0) {
+            return err("surface_mass_fraction", "must be in (0, 1]");
+        }
+        if let Some(mu) = s.max_viscosity_pa_s
+            && !positive(mu)
+        {
+            return err("max_viscosity_pa_s", "must be positive");
+        }
+        Ok(())
+    }
+
     fn validate(&self) -> Result<(), (String, String)> {
         let err = |field: &str, reason: String| Err((field.to_string(), reason));
         if self.dimension != 2 && self.dimension != 3 {
@@ -368,6 +491,9 @@ impl Case {
                     &format!("phases[{i}].name"),
                     format!("`{}` is defined twice", p.name),
                 );
+            }
+            if let Some(sed) = &p.sediment {
+                self.validate_sediment(i, sed)?;
             }
         }
         if self.fluid_blocks.is_empty() {

@@ -33,6 +33,10 @@ pub struct SphPipeline {
     reorder: Stage,
     forces_predict: Stage,
     forces_correct: Stage,
+    rheology_predict: Stage,
+    rheology_correct: Stage,
+    /// Viscous stress from the rheology pass before each force pass.
+    multiphase: bool,
     dt_update: Stage,
     symplectic_predictor: Stage,
     symplectic_corrector: Stage,
@@ -44,7 +48,13 @@ pub struct SphPipeline {
 }
 
 impl SphPipeline {
-    pub fn new(gpu: &GpuContext, dim: u32, divisions: u32, verlet: bool) -> SphPipeline {
+    pub fn new(
+        gpu: &GpuContext,
+        dim: u32,
+        divisions: u32,
+        verlet: bool,
+        multiphase: bool,
+    ) -> SphPipeline {
         let d = &gpu.device;
         let width = f64::from(2 * divisions + 1);
         let rows = if dim == 2 { width } else { width * width };
@@ -73,6 +83,17 @@ impl SphPipeline {
                 &stages::FORCES_WCSPH,
                 &[stencil[0], stencil[1], ("REDUCE_DT", 0.0)],
             ),
+            rheology_predict: Stage::new(
+                d,
+                &stages::RHEOLOGY,
+                &[stencil[0], stencil[1], ("BEFORE_DT", 1.0)],
+            ),
+            rheology_correct: Stage::new(
+                d,
+                &stages::RHEOLOGY,
+                &[stencil[0], stencil[1], ("BEFORE_DT", 0.0)],
+            ),
+            multiphase,
             dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
             symplectic_predictor: Stage::new(d, &stages::SYMPLECTIC_PREDICTOR, &[]),
             symplectic_corrector: Stage::new(d, &stages::SYMPLECTIC_CORRECTOR, &[]),
@@ -100,6 +121,11 @@ pub struct GpuBuffers {
     /// A copy of `a` taken at the start of each chunk, restored after a blow-up.
     pub snapshot: StateBuffers,
     pub c: StateTextures,
+    /// The rheology pass's viscous stress, (xx, xy, xz, yy) and (yz, zz, mu, region), and
+    /// region words (region | REGION_HELD), in cell order.
+    pub stress_a: wgpu::TextureView,
+    pub stress_b: wgpu::TextureView,
+    pub regions: wgpu::Buffer,
     pub forces: wgpu::Buffer,
     pub cell_of: wgpu::Buffer,
     pub cell_starts: wgpu::Buffer,
@@ -210,6 +236,9 @@ impl GpuBuffers {
                 vel_rho_prev: storage(gpu, "snapshot.vel_rho_prev", n * VEC4_BYTES),
             },
             c: StateTextures::new(gpu, "c", n),
+            stress_a: particle_texture(gpu, "stress_a", n, TEXEL_ROW_SHIFT),
+            stress_b: particle_texture(gpu, "stress_b", n, TEXEL_ROW_SHIFT),
+            regions: storage(gpu, "regions", n * 4),
             forces: storage(gpu, "forces", n * VEC4_BYTES),
             cell_of: storage(gpu, "cell_of", n * 4),
             cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),
@@ -234,6 +263,8 @@ pub struct Bindings {
     reorder: wgpu::BindGroup,
     forces_predict: wgpu::BindGroup,
     forces_correct: wgpu::BindGroup,
+    rheology_predict: wgpu::BindGroup,
+    rheology_correct: wgpu::BindGroup,
     dt_update: wgpu::BindGroup,
     symplectic_predictor: wgpu::BindGroup,
     symplectic_corrector: wgpu::BindGroup,
@@ -306,6 +337,8 @@ impl SphPipeline {
                     &g.cell_starts,
                     &g.forces,
                     &g.state,
+                    &g.stress_a,
+                    &g.stress_b,
                 ],
             ),
             forces_correct: self.forces_correct.bind(
@@ -317,6 +350,34 @@ impl SphPipeline {
                     &g.cell_starts,
                     &g.forces,
                     &g.state,
+                    &g.stress_a,
+                    &g.stress_b,
+                ],
+            ),
+            rheology_predict: self.rheology_predict.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.cell_starts,
+                    &g.state,
+                    &g.stress_a,
+                    &g.stress_b,
+                    &g.regions,
+                ],
+            ),
+            rheology_correct: self.rheology_correct.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.c.positions,
+                    &g.c.vel_rho,
+                    &g.cell_starts,
+                    &g.state,
+                    &g.stress_a,
+                    &g.stress_b,
+                    &g.regions,
                 ],
             ),
             dt_update: self.dt_update.bind(d, &[&g.params, &g.state]),
@@ -330,6 +391,7 @@ impl SphPipeline {
                     &g.b.vel_rho,
                     &g.c.positions,
                     &g.c.vel_rho,
+                    &g.regions,
                 ],
             ),
             symplectic_corrector: self.symplectic_corrector.bind(
@@ -345,6 +407,7 @@ impl SphPipeline {
                     &g.a.positions,
                     &g.a.vel_rho,
                     &g.a.ids,
+                    &g.regions,
                 ],
             ),
             verlet_update: self.verlet_update.bind(
@@ -361,6 +424,7 @@ impl SphPipeline {
                     &g.a.vel_rho,
                     &g.a.ids,
                     &g.a.vel_rho_prev,
+                    &g.regions,
                 ],
             ),
             probe_interpolate: self.probe_interpolate.bind(
@@ -404,11 +468,16 @@ impl SphPipeline {
         self.reorder.record_items(pass, 0, &b.reorder, n);
     }
 
-    /// One step: sort, forces at n, dt, then either the symplectic predictor, forces at
-    /// n + 1/2 and corrector, or the Verlet update (both as in DualSPHysics).
+    /// One step: sort, (rheology and) forces at n, dt, then either the symplectic predictor,
+    /// (rheology and) forces at n + 1/2 and corrector, or the Verlet update (both as in
+    /// DualSPHysics).
     pub fn record_step(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         self.record_sort(pass, b);
+        if self.multiphase {
+            self.rheology_predict
+                .record_items(pass, 0, &b.rheology_predict, n);
+        }
         self.forces_predict
             .record_items(pass, 0, &b.forces_predict, n);
         self.dt_update.record_items(pass, 0, &b.dt_update, 1);
@@ -418,6 +487,10 @@ impl SphPipeline {
         } else {
             self.symplectic_predictor
                 .record_items(pass, 0, &b.symplectic_predictor, n);
+            if self.multiphase {
+                self.rheology_correct
+                    .record_items(pass, 0, &b.rheology_correct, n);
+            }
             self.forces_correct
                 .record_items(pass, 0, &b.forces_correct, n);
             self.symplectic_corrector
@@ -428,6 +501,10 @@ impl SphPipeline {
     /// Forces at the current state only (no integration): for tests against the CPU oracle.
     pub fn record_forces(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
+        if self.multiphase {
+            self.rheology_predict
+                .record_items(pass, 0, &b.rheology_predict, b.n_particles);
+        }
         self.forces_predict
             .record_items(pass, 0, &b.forces_predict, b.n_particles);
     }

@@ -4,7 +4,8 @@
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s).
 
 use crate::case::{self, Derived, Particles, WALL_PHASE};
-use crate::config::{Case, DensityDiffusion, Integrator, Viscosity};
+use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
+use bytemuck::Zeroable;
 use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use crate::gpu::params::*;
 use crate::gpu::{GpuContext, GpuError};
@@ -232,8 +233,14 @@ impl Simulation {
             bytemuck::cast_slice(&probes.points),
         );
         let verlet = matches!(case.numerics.integrator, Integrator::Verlet { .. });
-        let pipeline =
-            SphPipeline::new(&gpu, case.dimension, divisions_of(case, derived.h), verlet);
+        let multiphase = matches!(case.numerics.viscosity, Viscosity::Multiphase);
+        let pipeline = SphPipeline::new(
+            &gpu,
+            case.dimension,
+            divisions_of(case, derived.h),
+            verlet,
+            multiphase,
+        );
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
         Ok(Simulation {
             gpu,
@@ -515,6 +522,26 @@ impl Simulation {
         Ok(out)
     }
 
+    /// Region words of the last rheology pass, in id order: the region 1-5 of Figure 2 (0 for
+    /// walls, and for every particle when the case has no multiphase viscosity), plus 256 for
+    /// sediment held fixed in that pass.
+    pub fn regions(&self) -> Result<Vec<u32>, SolverError> {
+        let n = self.particle_count() as u64;
+        let raw = read_buffers(
+            &self.gpu,
+            &[(&self.buffers.regions, n * 4), (&self.buffers.b_ids, n * 4)],
+        )?;
+        let words: Vec<u32> = cast_vec(&raw[0]);
+        let ids: Vec<u32> = cast_vec(&raw[1]);
+        let mut out = vec![0u32; n as usize];
+        for (&w, &id) in words.iter().zip(&ids) {
+            if let Some(slot) = out.get_mut(id as usize) {
+                *slot = w;
+            }
+        }
+        Ok(out)
+    }
+
     /// Forces and density rates (x, y, z acceleration, d rho/dt) of the current state, in id
     /// order, and the smallest stable step over particles (before the CFL factor), without
     /// advancing: the GPU side of the force-stage test.
@@ -654,6 +681,7 @@ fn sim_params(
     let (viscosity_mode, alpha) = match case.numerics.viscosity {
         Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha),
         Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0),
+        Viscosity::Multiphase => (VISCOSITY_MULTIPHASE, 0.0),
     };
     let (diffusion_mode, delta) = match case.numerics.density_diffusion {
         DensityDiffusion::None => (DIFFUSION_NONE, 0.0),
@@ -689,5 +717,50 @@ fn sim_params(
         pad: [0; 3],
         phases,
         tait_b,
+        sediment: sediment_params(case, derived),
+    }
+}
+
+/// The sediment block of the uniform; all zero (phase 0, the walls) when the case has none.
+fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
+    let Some((k_sed, k_water)) = case.sediment_phases() else {
+        return SedimentGpu::zeroed();
+    };
+    let sed = &case.phases[k_sed];
+    let Some(cfg) = &sed.sediment else {
+        return SedimentGpu::zeroed();
+    };
+    let water = &case.phases[k_water];
+    let phi = cfg.friction_angle_deg.to_radians();
+    let rho_s = sed.rho0_kg_per_m3;
+    let rho_w = water.rho0_kg_per_m3;
+    let mass = derived.phases[k_sed + 1].mass;
+    let mu_max = cfg
+        .max_viscosity_pa_s
+        .unwrap_or(0.125 * derived.h * rho_s * derived.c0);
+    SedimentGpu {
+        phase: (k_sed + 1) as u32,
+        water_phase: (k_water + 1) as u32,
+        shields_only: u32::from(cfg.criterion == YieldCriterion::ShieldsOnly),
+        pad: 0,
+        rho_s: rho_s as f32,
+        rho_w: rho_w as f32,
+        d50: cfg.d50_m as f32,
+        nu_w: (water.viscosity_pa_s / rho_w) as f32,
+        mu_w: water.viscosity_pa_s as f32,
+        mu_s: sed.viscosity_pa_s as f32,
+        hbp_m: cfg.hbp_m_s as f32,
+        hbp_n: cfg.hbp_n as f32,
+        ks: (cfg.ks_over_d50 * cfg.d50_m) as f32,
+        surface_mass: (cfg.surface_mass_fraction * mass) as f32,
+        dp_alpha: crate::physics::sediment::drucker_prager::alpha(phi as f32),
+        dp_kappa: crate::physics::sediment::drucker_prager::kappa_c(
+            phi as f32,
+            cfg.cohesion_pa as f32,
+        ),
+        phi: phi as f32,
+        mu_max: mu_max as f32,
+        submerged_weight: ((rho_s - rho_w) * case.gravity_magnitude()) as f32,
+        pad1: 0.0,
     }
 }

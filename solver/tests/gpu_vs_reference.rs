@@ -363,3 +363,92 @@ fn probe_interpolate_phase_fullness_matches_the_cpu() {
         }
     }
 }
+
+/// The rheology pass and the multiphase force pass against `sediment::pass`: regions word for
+/// word, accelerations (pressure plus stress divergence) within 1e-4 of the largest, and the
+/// stable step with each particle's viscous limit.
+fn check_rheology(c: Case, seed: u64) {
+    use flume_solver::physics::sediment::pass;
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    // Random velocities up to 0.3 m/s over a perturbed lattice: strain rates of tens per
+    // second, bed shear stresses on both sides of the Shields threshold, yielded and
+    // un-yielded sediment.
+    let (sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, seed);
+    let model = common::reference_sediment(&sim);
+    let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
+    let gpu_regions = sim.regions().expect("regions");
+    let rheology = pass::rheology_pass(&params, &model, &particles.positions, &particles.vel_rho);
+    let cpu_regions: Vec<u32> = rheology
+        .iter()
+        .map(|r| r.region | if r.held { 256 } else { 0 })
+        .collect();
+    // A comparison at a threshold (Shields, Drucker-Prager, c_v, the surface mass) may go
+    // either way under f32 rounding of sums taken in different orders; none did in this state.
+    let differ: Vec<usize> = (0..cpu_regions.len())
+        .filter(|&i| cpu_regions[i] != gpu_regions[i])
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "{} regions differ, first: particle {} gpu {} cpu {}",
+        differ.len(),
+        differ[0],
+        gpu_regions[differ[0]],
+        cpu_regions[differ[0]]
+    );
+    let mut count = [0usize; 6];
+    for r in &cpu_regions {
+        count[(*r & 255) as usize] += 1;
+    }
+    let mut cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
+    let stress = pass::stress_divergence(&params, &particles.positions, &particles.vel_rho, &rheology);
+    for (f, s) in cpu.forces.iter_mut().zip(&stress) {
+        for k in 0..3 {
+            f[k] += s[k];
+        }
+    }
+    assert_close("multiphase acceleration", &gpu_forces, &cpu.forces, c.dim(), 1e-4);
+    let h = params.h;
+    let cpu_dt = cpu
+        .dt_limit
+        .iter()
+        .zip(&rheology)
+        .zip(&particles.vel_rho)
+        .map(|((&dt, r), v)| {
+            if r.mu > 0.0 {
+                dt.min(0.125 * h * h * v[3] / r.mu)
+            } else {
+                dt
+            }
+        })
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        ((gpu_dt - cpu_dt) / cpu_dt).abs() < 1e-4,
+        "stable step: gpu {gpu_dt} cpu {cpu_dt}"
+    );
+    eprintln!(
+        "{}: regions (walls, 1-5) {count:?} agree; accelerations agree; stable step {gpu_dt:.3e} s",
+        c.name
+    );
+    // Every sediment region this test exists for occurs.
+    let wanted: &[usize] = if model.shields_only { &[1, 3] } else { &[1, 2, 3] };
+    for &r in wanted {
+        assert!(count[r] > 0, "no particle in region {r}: {count:?}");
+    }
+}
+
+#[test]
+fn rheology_matches_the_cpu_drucker_prager_shields() {
+    check_rheology(case("tests/cases/sediment_bed_2d.yaml"), 21);
+}
+
+#[test]
+fn rheology_matches_the_cpu_shields_only() {
+    let mut c = case("tests/cases/sediment_bed_2d.yaml");
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.criterion = flume_solver::config::YieldCriterion::ShieldsOnly;
+        s.hbp_m_s = 0.0;
+        s.hbp_n = 1.0;
+    }
+    check_rheology(c, 22);
+}

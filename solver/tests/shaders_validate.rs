@@ -1,7 +1,9 @@
 //! Tier 1, no GPU needed: every stage composes, naga validates it, its declared bindings and
 //! workgroup size match the WGSL, and the Rust mirrors of WGSL structs have naga's layout.
 
-use flume_solver::gpu::params::{Extremes, PhaseParams, ScanInfo, SimParams, StepState};
+use flume_solver::gpu::params::{
+    Extremes, PhaseParams, ScanInfo, SedimentGpu, SimParams, StepState,
+};
 use flume_solver::gpu::stage::Access;
 use flume_solver::stages::ALL;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
@@ -190,7 +192,32 @@ fn rust_mirrors_have_the_wgsl_layout() {
         n_probes,
         euler_every,
         phases,
-        tait_b
+        tait_b,
+        sediment
+    );
+    let (m, size) = wgsl_layout(&module, "Sediment");
+    assert_eq!(size as usize, size_of::<SedimentGpu>());
+    same!(
+        SedimentGpu,
+        m,
+        phase,
+        water_phase,
+        shields_only,
+        rho_s,
+        rho_w,
+        d50,
+        nu_w,
+        mu_w,
+        mu_s,
+        hbp_m,
+        hbp_n,
+        ks,
+        surface_mass,
+        dp_alpha,
+        dp_kappa,
+        phi,
+        mu_max,
+        submerged_weight
     );
     let (m, size) = wgsl_layout(&module, "Phase");
     assert_eq!(size as usize, size_of::<PhaseParams>());

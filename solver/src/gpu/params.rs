@@ -15,6 +15,32 @@ pub struct PhaseParams {
     pub mobile: f32,
 }
 
+/// Mirrors `Sediment` in `shaders/common/params.wgsl` (units there).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SedimentGpu {
+    pub phase: u32,
+    pub water_phase: u32,
+    pub shields_only: u32,
+    pub pad: u32,
+    pub rho_s: f32,
+    pub rho_w: f32,
+    pub d50: f32,
+    pub nu_w: f32,
+    pub mu_w: f32,
+    pub mu_s: f32,
+    pub hbp_m: f32,
+    pub hbp_n: f32,
+    pub ks: f32,
+    pub surface_mass: f32,
+    pub dp_alpha: f32,
+    pub dp_kappa: f32,
+    pub phi: f32,
+    pub mu_max: f32,
+    pub submerged_weight: f32,
+    pub pad1: f32,
+}
+
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct SimParams {
@@ -41,10 +67,12 @@ pub struct SimParams {
     pub pad: [u32; 3],
     pub phases: [PhaseParams; MAX_PHASES],
     pub tait_b: [f32; 4],
+    pub sediment: SedimentGpu,
 }
 
 pub const VISCOSITY_ARTIFICIAL: u32 = 0;
 pub const VISCOSITY_LAMINAR: u32 = 1;
+pub const VISCOSITY_MULTIPHASE: u32 = 2;
 pub const DIFFUSION_NONE: u32 = 0;
 pub const DIFFUSION_MOLTENI: u32 = 1;
 pub const DIFFUSION_FOURTAKAS: u32 = 2;

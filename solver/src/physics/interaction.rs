@@ -149,6 +149,8 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
                         acc[k] += s * v_ij[k];
                     }
                 }
+                // The viscous stress enters through `sediment::pass::stress_divergence`.
+                Viscosity::Multiphase => {}
             }
 
             visc_max = visc_max.max((h * vdotr / (r2 + eta2)).abs());

@@ -40,6 +40,9 @@ pub enum Viscosity {
     Artificial { alpha: f32 },
     /// Morris et al. (1997) laminar viscosity with each phase's dynamic viscosity `mu`.
     Laminar,
+    /// Viscous stress from each particle's strain rate (Eqs. 10-15): no pairwise viscous term
+    /// here, the stress divergence of [`sediment::pass`] instead.
+    Multiphase,
 }
 
 /// Numerical parameters of one run.

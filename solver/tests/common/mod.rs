@@ -43,7 +43,7 @@ pub fn validation_path(name: &str) -> std::path::PathBuf {
 
 /// The CPU oracle's parameters for a simulation, read from the very uniform the GPU uses.
 pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics::Params {
-    use flume_solver::gpu::params::VISCOSITY_ARTIFICIAL;
+    use flume_solver::gpu::params::{VISCOSITY_ARTIFICIAL, VISCOSITY_LAMINAR};
     use flume_solver::physics::{Params, Phase, Viscosity};
     let p = sim.params();
     let n_phases = sim.derived().phases.len();
@@ -54,10 +54,10 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
         gravity: [p.gravity[0], p.gravity[1], p.gravity[2]],
         delta: p.delta_h_c0 / (p.h * p.c0),
         hydrostatic_diffusion: p.diffusion_mode == flume_solver::gpu::params::DIFFUSION_FOURTAKAS,
-        viscosity: if p.viscosity_mode == VISCOSITY_ARTIFICIAL {
-            Viscosity::Artificial { alpha: p.alpha }
-        } else {
-            Viscosity::Laminar
+        viscosity: match p.viscosity_mode {
+            VISCOSITY_ARTIFICIAL => Viscosity::Artificial { alpha: p.alpha },
+            VISCOSITY_LAMINAR => Viscosity::Laminar,
+            _ => Viscosity::Multiphase,
         },
         cfl: p.cfl,
         phases: p.phases[..n_phases]
@@ -69,6 +69,35 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
                 mobile: ph.mobile > 0.5,
             })
             .collect(),
+    }
+}
+
+/// The CPU oracle's sediment model, read from the uniform the GPU uses.
+pub fn reference_sediment(
+    sim: &flume_solver::Simulation,
+) -> flume_solver::physics::sediment::pass::SedimentModel {
+    use flume_solver::physics::sediment::SedimentParams;
+    let s = sim.params().sediment;
+    let mass = sim.params().phases[s.phase as usize].mass;
+    flume_solver::physics::sediment::pass::SedimentModel {
+        material: SedimentParams {
+            rho_s: s.rho_s,
+            d50_m: s.d50,
+            phi_rad: s.phi,
+            cohesion_pa: 0.0,
+            hbp_m: s.hbp_m,
+            hbp_n: s.hbp_n,
+            mu_s_pa_s: s.mu_s,
+            ks_over_d50: s.ks / s.d50,
+            surface_mass_fraction: s.surface_mass / mass,
+            rho_w: s.rho_w,
+            nu_w: s.nu_w,
+            mu_w: s.mu_w,
+        },
+        sediment_phase: s.phase as usize,
+        water_phase: s.water_phase as usize,
+        shields_only: s.shields_only != 0,
+        mu_max: s.mu_max,
     }
 }
 

@@ -16,6 +16,7 @@
 //! `shared/MODEL.md`.
 
 pub mod drucker_prager;
+pub mod pass;
 pub mod rheology;
 pub mod shields;
 pub mod suspension;

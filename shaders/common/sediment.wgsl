@@ -1,0 +1,175 @@
+// Formulas of the sediment model (Zubeldia et al. 2018), one function per equation; the
+// reference of each is the function of the same name in solver/src/physics/sediment/.
+
+const KARMAN: f32 = 0.41;
+const SUBLAYER_WALL_UNITS: f32 = 11.6;
+const SMOOTH_RE_K: f32 = 5.0;
+const ROUGH_RE_K: f32 = 70.0;
+const Z0_SMOOTH: f32 = 0.11;
+const Z0_ROUGH: f32 = 0.033;
+const FRICTION_VELOCITY_MAX_ITERATIONS: u32 = 64u;
+const BISECTION_REL_TOL: f32 = 4.0 * 1.1920929e-7;
+const SUSPENSION_CONCENTRATION: f32 = 0.3;
+const PAPANASTASIOU_SERIES_LIMIT: f32 = 0.1;
+const HUGE: f32 = 3.0e38;
+
+const REGION_UNYIELDED: u32 = 1u;
+const REGION_YIELDED: u32 = 2u;
+const REGION_BED_LOAD: u32 = 3u;
+const REGION_SUSPENDED: u32 = 4u;
+const REGION_WATER: u32 = 5u;
+// Set in a particle's region word when it is held fixed this step.
+const REGION_HELD: u32 = 256u;
+
+// Eq. 17 (van Rijn 1993); "infinite" (HUGE) at Re* <= 0.
+fn critical_shields(re_star: f32) -> f32 {
+    if (re_star >= 500.0) {
+        return 0.068;
+    }
+    if (re_star > 0.0) {
+        return 0.010595 * log(re_star) + 0.110476 / re_star + 0.0027197;
+    }
+    return HUGE;
+}
+
+// Eq. 21 for one regime: 0 smooth, 1 transitional, 2 rough.
+fn z0_in(regime: u32, u_star: f32, ks: f32, nu: f32) -> f32 {
+    switch (regime) {
+        case 0u: { return Z0_SMOOTH * nu / u_star; }
+        case 1u: { return Z0_SMOOTH * nu / u_star + Z0_ROUGH * ks; }
+        default: { return Z0_ROUGH * ks; }
+    }
+}
+
+// Eq. 20, the log law with the z0 of `regime`.
+fn log_profile(regime: u32, z: f32, u_star: f32, ks: f32, nu: f32) -> f32 {
+    return u_star / KARMAN * log(z / z0_in(regime, u_star, ks, nu));
+}
+
+// Friction velocity u* such that the profile of Eqs. 19-21 passes through speed u at height z
+// above the bed: the viscous sub-layer first, then the log law regime by regime, bisecting
+// within the regime whose u* range brackets the solution (see `friction_velocity` in
+// shields.rs, whose bracket and stopping rules this follows step for step).
+fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> f32 {
+    if (!(u > 0.0) || !(z > 0.0) || u > HUGE) {
+        return 0.0;
+    }
+    let sublayer_top = SUBLAYER_WALL_UNITS * nu / z;
+    let guess = sqrt(u * nu / z);
+    if (guess <= sublayer_top) {
+        return guess;
+    }
+    let smooth_top = SMOOTH_RE_K * nu / ks;
+    let rough_bottom = ROUGH_RE_K * nu / ks;
+    for (var regime = 0u; regime < 3u; regime++) {
+        var lo = sublayer_top;
+        var hi = smooth_top;
+        if (regime == 1u) {
+            lo = max(sublayer_top, smooth_top);
+            hi = rough_bottom;
+        } else if (regime == 2u) {
+            lo = max(sublayer_top, rough_bottom);
+            hi = HUGE;
+        }
+        if (lo >= hi) {
+            continue;
+        }
+        if (log_profile(regime, z, lo, ks, nu) >= u) {
+            return lo;
+        }
+        if (regime == 2u) {
+            let log_ratio = log(z / (Z0_ROUGH * ks));
+            if (!(log_ratio > 0.0)) {
+                break;
+            }
+            return max(KARMAN * u / log_ratio, lo);
+        }
+        if (regime == 0u) {
+            hi = min(hi, u * KARMAN / log(50.0));
+        }
+        if (log_profile(regime, z, hi, ks, nu) < u) {
+            continue;
+        }
+        var iterations = 0u;
+        while (hi - lo > BISECTION_REL_TOL * hi) {
+            let mid = 0.5 * (lo + hi);
+            if (mid <= lo || mid >= hi || iterations == FRICTION_VELOCITY_MAX_ITERATIONS) {
+                break;
+            }
+            iterations++;
+            if (log_profile(regime, z, mid, ks, nu) >= u) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        return hi;
+    }
+    return sublayer_top;
+}
+
+// Eq. 22: k_beta, flow down the slope or up it.
+fn k_beta(beta: f32, phi: f32, down: bool) -> f32 {
+    let b = abs(beta);
+    let s = select(sin(phi + b), sin(phi - b), down);
+    return max(s / sin(phi), 0.0);
+}
+
+// Eq. 23: k_gamma.
+fn k_gamma(gamma: f32, phi: f32) -> f32 {
+    let g = abs(gamma);
+    if (g >= phi) {
+        return 0.0;
+    }
+    let r = tan(g) / tan(phi);
+    return cos(g) * sqrt(max(1.0 - r * r, 0.0));
+}
+
+// k_beta k_gamma from the bed's outward normal n and the flow u over it (`slope_factors` in
+// pass.rs): the slope is the normal's tilt along and across the flow's horizontal direction.
+fn slope_factors(n: vec3<f32>, u: vec3<f32>, phi: f32) -> f32 {
+    let v = params.vertical_axis;
+    var uh = u;
+    uh[v] = 0.0;
+    let speed_h = length(uh);
+    let n_len = length(n);
+    if (speed_h == 0.0 || n_len == 0.0) {
+        return 1.0;
+    }
+    var nh = n;
+    nh[v] = 0.0;
+    let n_s = dot(nh, uh) / speed_h;
+    var n_t = 0.0;
+    if (v == 2u) {
+        n_t = (n.x * u.y - n.y * u.x) / speed_h;
+    }
+    let beta = atan2(abs(n_s), n[v]);
+    let gamma = atan2(abs(n_t), n[v]);
+    return k_beta(beta, phi, n_s > 0.0) * k_gamma(gamma, phi);
+}
+
+// (1 - exp(-x)) / x, continuous through x = 0.
+fn papanastasiou_factor(x: f32) -> f32 {
+    if (x < PAPANASTASIOU_SERIES_LIMIT) {
+        return 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x / 120.0)));
+    }
+    return (1.0 - exp(-x)) / x;
+}
+
+// Eq. 15, the HBP apparent viscosity, Pa s.
+fn hbp_viscosity(ii_d: f32, tau_c: f32) -> f32 {
+    let sd = params.sediment;
+    let d = max(ii_d, 0.0);
+    let s = sqrt(d);
+    let yield_term = tau_c * sd.hbp_m * papanastasiou_factor(sd.hbp_m * s);
+    var power_term = 2.0 * sd.mu_s;
+    if (sd.hbp_n != 1.0) {
+        power_term *= pow(4.0 * d, 0.5 * (sd.hbp_n - 1.0));
+    }
+    return yield_term + power_term;
+}
+
+// Eq. 33, Vand's suspension viscosity, Pa s.
+fn vand_viscosity(c_v: f32) -> f32 {
+    return params.sediment.mu_w * exp(2.5 * c_v / (1.0 - 39.0 / 64.0 * c_v));
+}

@@ -1,0 +1,158 @@
+// Rheology pass of the water-sediment model (Zubeldia et al. 2018): per particle, the velocity
+// gradient and strain rate (Eqs. 12-13); for sediment the Drucker-Prager yield stress
+// (Eqs. 27-31), the bed-surface test (Eq. 26), the Shields criterion with the nearest water
+// particle (Eqs. 16-25), the concentration (Eq. 32), the region of Figure 2 and its apparent
+// viscosity (Eqs. 15, 33); then the viscous stress tau = 2 mu eps that the force pass
+// differentiates. Reference: solver/src/physics/sediment/pass.rs.
+
+@group(0) @binding(1) var positions: texture_2d<f32>;
+@group(0) @binding(2) var vel_rho: texture_2d<f32>;
+@group(0) @binding(3) var<storage, read> cell_starts: array<u32>;
+@group(0) @binding(4) var<storage, read_write> state: StepState;
+@group(0) @binding(5) var stress_a: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(6) var stress_b: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(7) var<storage, read_write> regions: array<u32>;
+
+// The predictor's pass runs before dt_update, the corrector's after it; each skips idle steps
+// the way the force pass that follows it does.
+override BEFORE_DT: bool = true;
+
+@compute @workgroup_size(64)
+fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    let idle = select(state.dt == 0.0, state.t_rel >= state.t_target, BEFORE_DT);
+    if (i >= params.n_particles || idle || atomicLoad(&state.status) != 0u) {
+        return;
+    }
+    let pos_i = textureLoad(positions, texel(i), 0);
+    let vr_i = textureLoad(vel_rho, texel(i), 0);
+    let phase_i = bitcast<u32>(pos_i.w);
+    let ph_i = params.phases[phase_i];
+    if (ph_i.mobile < 0.5) {
+        textureStore(stress_a, texel(i), vec4<f32>(0.0));
+        textureStore(stress_b, texel(i), vec4<f32>(0.0));
+        regions[i] = 0u;
+        return;
+    }
+    let sd = params.sediment;
+    let is_sediment = phase_i == sd.phase && sd.phase != 0u;
+    let h = params.h;
+    let four_h2 = 4.0 * h * h;
+    let r2_min = 1e-12 * h * h;
+    let rho_i = vr_i.w;
+
+    // grad[b] is the column du/dx_b.
+    var grad = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    var sediment_volume = 0.0;
+    var mixture_volume = 0.0;
+    var kernel_mass = 0.0;
+    var normal = vec3<f32>(0.0);
+    var nearest_r2 = HUGE;
+    var nearest_du = vec3<f32>(0.0);
+    if (is_sediment) {
+        let v_i = ph_i.mass / rho_i;
+        sediment_volume = v_i;
+        mixture_volume = v_i;
+        kernel_mass = ph_i.mass * kernel_w(0.0) * v_i;
+    }
+    let cell = cell_coords(pos_i.xyz);
+    for (var row = 0u; row < STENCIL_ROWS; row++) {
+        let range = stencil_row(cell, row);
+        for (var j = range.x; j < range.y; j++) {
+            let pos_j = textureLoad(positions, texel(j), 0);
+            let dx = pos_i.xyz - pos_j.xyz;
+            let r2 = dot(dx, dx);
+            if (r2 >= four_h2 || r2 < r2_min) {
+                continue;
+            }
+            let phase_j = bitcast<u32>(pos_j.w);
+            let vr_j = textureLoad(vel_rho, texel(j), 0);
+            let m_j = params.phases[phase_j].mass;
+            let v_j = m_j / vr_j.w;
+            let r = sqrt(r2);
+            let gw = dx * kernel_grad_factor(r);
+            let du = vr_j.xyz - vr_i.xyz;
+            grad += mat3x3<f32>(du * (v_j * gw.x), du * (v_j * gw.y), du * (v_j * gw.z));
+            if (!is_sediment) {
+                continue;
+            }
+            if (phase_j == sd.phase) {
+                sediment_volume += v_j;
+                mixture_volume += v_j;
+                kernel_mass += m_j * kernel_w(r) * v_j;
+            } else if (phase_j == sd.water_phase) {
+                mixture_volume += v_j;
+                normal += v_j * gw;
+                if (r2 < nearest_r2) {
+                    nearest_r2 = r2;
+                    nearest_du = du;
+                }
+            }
+        }
+    }
+
+    // Eq. 12, the trace correction 1/3 in 2-D too (see rheology.rs).
+    let dim_3d = params.vertical_axis == 2u;
+    let trace = grad[0].x + grad[1].y + select(0.0, grad[2].z, dim_3d);
+    var eps = 0.5 * (grad + transpose(grad));
+    eps[0].x -= trace / 3.0;
+    eps[1].y -= trace / 3.0;
+    if (dim_3d) {
+        eps[2].z -= trace / 3.0;
+    } else {
+        eps[2] = vec3<f32>(0.0);
+        eps[0].z = 0.0;
+        eps[1].z = 0.0;
+    }
+    let ii_d = 0.5 * (dot(eps[0], eps[0]) + dot(eps[1], eps[1]) + dot(eps[2], eps[2]));
+
+    var mu = ph_i.mu;
+    var region = REGION_WATER;
+    if (is_sediment) {
+        let p_skel = tait_pressure(rho_i, phase_i) * (1.0 - sd.rho_w / sd.rho_s);
+        let tau_y = sd.dp_alpha * max(p_skel, 0.0) + sd.dp_kappa;
+        let has_water = nearest_r2 < HUGE;
+        let at_surface = has_water && kernel_mass < sd.surface_mass;
+        var tau_b = 0.0;
+        var tau_bcr = HUGE;
+        if (at_surface) {
+            let u_star = friction_velocity(length(nearest_du), sqrt(nearest_r2), sd.ks, sd.nu_w);
+            let theta = critical_shields(u_star * sd.d50 / sd.nu_w);
+            let k = slope_factors(normal, nearest_du, sd.phi);
+            tau_b = sd.rho_w * u_star * u_star;
+            tau_bcr = k * theta * sd.submerged_weight * sd.d50;
+        }
+        let c_v = clamp(sediment_volume / mixture_volume, 0.0, 1.0);
+        let bed_load = at_surface && tau_b > tau_bcr;
+        if (sd.shields_only != 0u) {
+            if (c_v < SUSPENSION_CONCENTRATION) {
+                region = REGION_SUSPENDED;
+            } else if (bed_load) {
+                region = REGION_BED_LOAD;
+            } else {
+                region = REGION_UNYIELDED;
+            }
+        } else {
+            if (bed_load) {
+                region = REGION_BED_LOAD;
+            } else {
+                let sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
+                region = select(REGION_UNYIELDED, REGION_YIELDED, sqrt_j2 > tau_y);
+            }
+            if (region != REGION_UNYIELDED && c_v < SUSPENSION_CONCENTRATION) {
+                region = REGION_SUSPENDED;
+            }
+        }
+        switch (region) {
+            case 3u: { mu = hbp_viscosity(ii_d, tau_bcr); }
+            case 4u: { mu = vand_viscosity(c_v); }
+            default: { mu = hbp_viscosity(ii_d, tau_y); }
+        }
+        mu = min(mu, sd.mu_max);
+    }
+    let held = sd.shields_only != 0u && region == REGION_UNYIELDED;
+    let t = select(2.0 * mu, 0.0, held) * eps;
+    textureStore(stress_a, texel(i), vec4<f32>(t[0].x, t[1].x, t[2].x, t[1].y));
+    textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(region)));
+    regions[i] = region | select(0u, REGION_HELD, held);
+}

@@ -1,0 +1,374 @@
+//! The rheology pass of the water-sediment model, brute force over all pairs: for every particle
+//! its strain rate, region and apparent viscosity, hence its viscous stress `tau = 2 mu eps`
+//! (Eqs. 11-15, 26-33, Figure 2); then the stress divergence of the momentum equation (Eq. 10).
+//! The GPU's `shaders/stages/rheology.wgsl` and the multiphase branch of `forces_wcsph.wgsl`
+//! must give the same numbers (up to summation order).
+//!
+//! Choices the paper leaves open, each stated where it is made:
+//! - the skeleton pressure of Drucker-Prager ([`skeleton_pressure`]);
+//! - what the Shields-only mode does with a sediment particle that is neither eroded nor inside
+//!   the bed ([`classify_shields_only`]);
+//! - the cap on the apparent viscosity ([`SedimentModel::mu_max`]);
+//! - the bed slope, from the normal of the sediment-water interface ([`slope_factors`]).
+
+use super::drucker_prager::{alpha, kappa_c, yield_stress};
+use super::rheology::{Tensor3, hbp_viscosity, second_invariant, strain_rate};
+use super::shields::{
+    bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity, k_beta,
+    k_gamma, sloped_critical_stress,
+};
+use super::suspension::{
+    Region, SUSPENSION_CONCENTRATION, apparent_viscosity, classify, volume_fraction,
+};
+use super::SedimentParams;
+use crate::physics::Params;
+use crate::physics::eos::{pressure, tait_b};
+use crate::physics::interaction::phase_index;
+use crate::physics::kernel::{grad_factor, w};
+
+/// The sediment model of one run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SedimentModel {
+    pub material: SedimentParams,
+    /// Index in `Params::phases` of the sediment and of the water.
+    pub sediment_phase: usize,
+    pub water_phase: usize,
+    /// The paper's Shields-only mode: sediment that is neither eroded nor suspended is held
+    /// fixed, and Drucker-Prager is not used.
+    pub shields_only: bool,
+    /// Largest apparent viscosity, Pa s. An explicit scheme is stable for
+    /// `dt <= 0.125 h^2 rho / mu`; the un-yielded HBP viscosity (tau_y m, tens of thousands of
+    /// Pa s for the Louvain bed) would need steps 10^4 times shorter than the acoustic ones.
+    pub mu_max: f32,
+}
+
+/// What the rheology pass gives one particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParticleRheology {
+    /// Viscous stress `tau = 2 mu eps`, Pa; zero for walls.
+    pub stress: Tensor3,
+    /// Apparent viscosity, Pa s (after the cap); zero for walls.
+    pub mu: f32,
+    /// Region 1-5 of Figure 2 (5 for water), 0 for walls.
+    pub region: u32,
+    /// Held fixed this step (Shields-only mode, sediment neither eroded nor suspended).
+    pub held: bool,
+}
+
+/// Sums one sediment particle gathers from its neighbours.
+#[derive(Default)]
+struct Gathered {
+    sediment_volume: f32,
+    mixture_volume: f32,
+    kernel_mass: f32,
+    /// `sum_water V_j grad_i W_ij`: points from the sediment into the water.
+    normal: [f32; 3],
+    nearest_water: Option<(f32, usize)>,
+}
+
+/// Skeleton pressure p of Eq. 31, Pa, from the sediment particle's pressure `p` (its Tait
+/// pressure, total: grains and pore water).
+///
+/// The paper calls it the skeleton pressure without saying how the pore water pressure is taken
+/// out. Here the pore water carries the fraction `rho_w / rho_s` of the total:
+/// `p_skel = p (1 - rho_w / rho_s)`. At depth d below a bed surface that is itself at the free
+/// surface this is exactly the effective stress `(rho_s - rho_w) g d`; under a water column of
+/// pressure p_top it adds `p_top (1 - rho_w / rho_s)`, making the bed stronger than it is. A
+/// pore pressure carried from the water above would remove that bias at the cost of one more
+/// per-particle state.
+pub fn skeleton_pressure(p: f32, rho_s: f32, rho_w: f32) -> f32 {
+    p * (1.0 - rho_w / rho_s)
+}
+
+/// `k_beta k_gamma` of Eqs. 22-24 from the bed's outward normal `n` (any length, pointing into
+/// the water) and the flow velocity `u` over it, in `dim` dimensions (vertical axis `dim - 1`).
+///
+/// The slope is the normal's tilt: `tan(beta) = n_s / n_v` along the flow's horizontal direction
+/// s, `tan(gamma) = |n_t| / n_v` across it (3-D only). The flow runs down the slope when the
+/// normal leans the way the flow goes (`n_s > 0`). With no horizontal flow, or no normal, the
+/// bed counts as flat (factor 1); a normal pointing down (an overhang) gives beta >= 90 degrees.
+pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
+    let v = (dim - 1) as usize;
+    let horizontal = if dim == 2 { 1 } else { 2 };
+    let speed_h: f32 = (0..horizontal).map(|k| u[k] * u[k]).sum::<f32>().sqrt();
+    let n_len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if speed_h == 0.0 || n_len == 0.0 {
+        return 1.0;
+    }
+    let mut n_s = 0.0;
+    for k in 0..horizontal {
+        n_s += n[k] * u[k] / speed_h;
+    }
+    let n_t = if dim == 3 {
+        (n[0] * u[1] - n[1] * u[0]) / speed_h
+    } else {
+        0.0
+    };
+    let beta = n_s.abs().atan2(n[v]);
+    let gamma = n_t.abs().atan2(n[v]);
+    k_beta(beta, phi, n_s > 0.0) * k_gamma(gamma, phi)
+}
+
+/// Region of a sediment particle in the Shields-only mode: bed load where Eq. 25 holds, then
+/// suspended wherever `c_v < 0.3` (eroded or not: a grain that has left the bed is carried by
+/// the water even when the flow next to it is below the Shields threshold), otherwise held.
+pub fn classify_shields_only(at_surface: bool, tau_b: f32, tau_bcr: f32, c_v: f32) -> Region {
+    if c_v < SUSPENSION_CONCENTRATION {
+        Region::Suspended
+    } else if at_surface && tau_b > tau_bcr {
+        Region::BedLoad
+    } else {
+        Region::Unyielded
+    }
+}
+
+fn sub3(a: &[f32; 4], b: &[f32; 4]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm3(a: [f32; 3]) -> f32 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// The rheology of every particle (see the module doc).
+///
+/// Panics if the slices differ in length or a phase index is outside `params.phases` (bugs of
+/// the caller).
+pub fn rheology_pass(
+    params: &Params,
+    model: &SedimentModel,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+) -> Vec<ParticleRheology> {
+    assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
+    let h = params.h;
+    let dim = params.dim;
+    let support2 = 4.0 * h * h;
+    let coincident2 = 1e-12 * h * h;
+    let g = -params.gravity[(dim - 1) as usize];
+    let mat = &model.material;
+    let alpha_dp = alpha(mat.phi_rad);
+    let kappa_dp = kappa_c(mat.phi_rad, mat.cohesion_pa);
+    let sed = &params.phases[model.sediment_phase];
+    let reference_mass = mat.surface_mass_fraction * sed.mass;
+    let in_mixture = |k: usize| k == model.sediment_phase || k == model.water_phase;
+
+    (0..pos.len())
+        .map(|i| {
+            let pi = phase_index(&pos[i]);
+            let phase_i = &params.phases[pi];
+            if !phase_i.mobile {
+                return ParticleRheology {
+                    stress: [[0.0; 3]; 3],
+                    mu: 0.0,
+                    region: 0,
+                    held: false,
+                };
+            }
+            let is_sediment = pi == model.sediment_phase;
+            let rho_i = vel_rho[i][3];
+            let mut grad = [[0.0_f32; 3]; 3];
+            let mut s = Gathered::default();
+            if is_sediment {
+                let v_i = sed.mass / rho_i;
+                s.sediment_volume = v_i;
+                s.mixture_volume = v_i;
+                s.kernel_mass = sed.mass * w(0.0, h, dim) * v_i;
+            }
+            for j in 0..pos.len() {
+                let x_ij = sub3(&pos[i], &pos[j]);
+                let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
+                if j == i || r2 >= support2 || r2 < coincident2 {
+                    continue;
+                }
+                let pj = phase_index(&pos[j]);
+                let m_j = params.phases[pj].mass;
+                let v_j = m_j / vel_rho[j][3];
+                let r = r2.sqrt();
+                let f = grad_factor(r, h, dim);
+                let du = sub3(&vel_rho[j], &vel_rho[i]);
+                for a in 0..3 {
+                    for b in 0..3 {
+                        grad[a][b] += v_j * du[a] * x_ij[b] * f;
+                    }
+                }
+                if !is_sediment || !in_mixture(pj) {
+                    continue;
+                }
+                s.mixture_volume += v_j;
+                if pj == model.sediment_phase {
+                    s.sediment_volume += v_j;
+                    s.kernel_mass += m_j * w(r, h, dim) * v_j;
+                } else {
+                    for (k, n) in s.normal.iter_mut().enumerate() {
+                        *n += v_j * f * x_ij[k];
+                    }
+                    if s.nearest_water.is_none_or(|(rn, _)| r < rn) {
+                        s.nearest_water = Some((r, j));
+                    }
+                }
+            }
+            let eps = strain_rate(&grad, dim);
+            let ii_d = second_invariant(&eps);
+            let (region, mu, held) = if is_sediment {
+                let p = pressure(rho_i, sed.rho0, tait_b(params.c0, sed.rho0));
+                let tau_y = yield_stress(
+                    alpha_dp,
+                    kappa_dp,
+                    skeleton_pressure(p, mat.rho_s, mat.rho_w),
+                );
+                let at_surface = s.nearest_water.is_some() && s.kernel_mass < reference_mass;
+                let (tau_b, tau_bcr) = match s.nearest_water {
+                    Some((z, j)) if at_surface => {
+                        let u = sub3(&vel_rho[j], &vel_rho[i]);
+                        let u_star = friction_velocity(norm3(u), z, mat.ks_m(), mat.nu_w).u_star;
+                        let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
+                        let tau_bcr0 =
+                            critical_bed_shear_stress(theta, mat.rho_s, mat.rho_w, g, mat.d50_m);
+                        let k = slope_factors(s.normal, u, dim, mat.phi_rad);
+                        (
+                            bed_shear_stress(mat.rho_w, u_star),
+                            sloped_critical_stress(tau_bcr0, k, 1.0),
+                        )
+                    }
+                    _ => (0.0, f32::INFINITY),
+                };
+                let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
+                let region = if model.shields_only {
+                    classify_shields_only(at_surface, tau_b, tau_bcr, c_v)
+                } else {
+                    let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
+                    let sqrt_j2 = 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt();
+                    classify(true, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v)
+                };
+                let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
+                let held = model.shields_only && region == Region::Unyielded;
+                (region as u32, mu.min(model.mu_max), held)
+            } else {
+                (Region::Water as u32, phase_i.mu, false)
+            };
+            let mut stress = [[0.0_f32; 3]; 3];
+            if !held {
+                for a in 0..3 {
+                    for b in 0..3 {
+                        stress[a][b] = 2.0 * mu * eps[a][b];
+                    }
+                }
+            }
+            ParticleRheology {
+                stress,
+                mu,
+                region,
+                held,
+            }
+        })
+        .collect()
+}
+
+/// Viscous part of the momentum equation (Eq. 10 with sigma = -p I + tau):
+/// `sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij`, m/s2, for every mobile
+/// particle (zero for walls), with the stresses of [`rheology_pass`].
+pub fn stress_divergence(
+    params: &Params,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+    rheology: &[ParticleRheology],
+) -> Vec<[f32; 3]> {
+    let h = params.h;
+    let support2 = 4.0 * h * h;
+    let coincident2 = 1e-12 * h * h;
+    (0..pos.len())
+        .map(|i| {
+            let mut acc = [0.0_f32; 3];
+            if !params.phases[phase_index(&pos[i])].mobile {
+                return acc;
+            }
+            let rho_i = vel_rho[i][3];
+            let t_i = &rheology[i].stress;
+            for j in 0..pos.len() {
+                let x_ij = sub3(&pos[i], &pos[j]);
+                let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
+                if j == i || r2 >= support2 || r2 < coincident2 {
+                    continue;
+                }
+                let m_j = params.phases[phase_index(&pos[j])].mass;
+                let rho_j = vel_rho[j][3];
+                let t_j = &rheology[j].stress;
+                let f = grad_factor(r2.sqrt(), h, params.dim);
+                for a in 0..3 {
+                    for b in 0..3 {
+                        let t = t_i[a][b] / (rho_i * rho_i) + t_j[a][b] / (rho_j * rho_j);
+                        acc[a] += m_j * t * x_ij[b] * f;
+                    }
+                }
+            }
+            acc
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DEG: f32 = std::f32::consts::PI / 180.0;
+
+    #[test]
+    fn flat_bed_has_unit_slope_factor() {
+        // Normal straight up: beta = gamma = 0, Eqs. 22-23 give sin(phi)/sin(phi) = 1 and
+        // cos(0) sqrt(1 - 0) = 1, whichever way the water flows.
+        for u in [[0.3, 0.0, 0.0], [-0.3, 0.0, 0.0]] {
+            assert_eq!(slope_factors([0.0, 1.0, 0.0], u, 2, 30.0 * DEG), 1.0);
+        }
+        assert_eq!(
+            slope_factors([0.0, 0.0, 2.0], [0.1, 0.2, 0.0], 3, 30.0 * DEG),
+            1.0
+        );
+    }
+
+    #[test]
+    fn slope_factor_by_hand() {
+        // A 2-D bed sloping down towards +x at 10 deg: outward normal (sin 10, cos 10).
+        // Flow towards +x runs down the slope: sin(30 - 10) / sin 30 = 0.342020 / 0.5 = 0.684040.
+        // Flow towards -x runs up it: sin(40) / sin(30) = 0.642788 / 0.5 = 1.285575.
+        let n = [(10.0 * DEG).sin(), (10.0 * DEG).cos(), 0.0];
+        let down = slope_factors(n, [0.2, 0.0, 0.0], 2, 30.0 * DEG);
+        let up = slope_factors(n, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
+        assert!((down - 0.684_040).abs() < 1e-5, "{down}");
+        assert!((up - 1.285_575).abs() < 1e-5, "{up}");
+        // 3-D, the same tilt across a flow along y: gamma = 10 deg, beta = 0;
+        // cos 10 sqrt(1 - tan^2 10 / tan^2 30) = 0.984808 sqrt(1 - 0.031091 / 0.333333)
+        // = 0.984808 * 0.952048 = 0.937585.
+        let n3 = [(10.0 * DEG).sin(), 0.0, (10.0 * DEG).cos()];
+        let across = slope_factors(n3, [0.0, 0.2, 0.0], 3, 30.0 * DEG);
+        assert!((across - 0.937_585).abs() < 1e-5, "{across}");
+    }
+
+    #[test]
+    fn skeleton_pressure_is_effective_stress_at_the_surface() {
+        // 5 cm below a bed surface that is the free surface: p = rho_s g d = 2710 * 9.81 * 0.05
+        // = 1329.255 Pa; effective stress (rho_s - rho_w) g d = 1710 * 9.81 * 0.05 = 838.755 Pa.
+        let p = skeleton_pressure(1329.255, 2710.0, 1000.0);
+        assert!((p - 838.755).abs() < 1e-2, "{p}");
+    }
+
+    #[test]
+    fn shields_only_regions() {
+        assert_eq!(
+            classify_shields_only(true, 0.5, 0.2, 0.6),
+            Region::BedLoad
+        );
+        assert_eq!(
+            classify_shields_only(true, 0.1, 0.2, 0.6),
+            Region::Unyielded
+        );
+        assert_eq!(
+            classify_shields_only(false, 0.5, 0.2, 0.6),
+            Region::Unyielded
+        );
+        assert_eq!(
+            classify_shields_only(true, 0.1, 0.2, 0.1),
+            Region::Suspended
+        );
+    }
+}
