@@ -186,6 +186,9 @@ impl Recorder {
         let particles = sim
             .read_particles()
             .context("cannot read the particles back from the GPU")?;
+        let regions = sim
+            .regions()
+            .context("cannot read the particle regions back from the GPU")?;
         let path = self.dir.join(name);
         let tmp = self.dir.join(format!("{name}.part"));
         let title = format!(
@@ -196,7 +199,7 @@ impl Recorder {
         );
         let file =
             File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
-        vtk::write_particles(BufWriter::new(file), &title, &particles)
+        vtk::write_particles(BufWriter::new(file), &title, &particles, &regions)
             .and_then(|()| fs::rename(&tmp, &path))
             .with_context(|| format!("cannot write {}", path.display()))
     }

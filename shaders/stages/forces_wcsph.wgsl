@@ -77,8 +77,14 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
             let vr_j = textureLoad(vel_rho, texel(j), 0);
             let dv = vr_i.xyz - vr_j.xyz;
             let f = kernel_grad_factor(sqrt(r2));
-            let m_j = params.phases[phase_j].mass;
-            let rho_j = vr_j.w;
+            // A wall seen from a fluid particle stands in for that fluid (`wall_scale` in
+            // interaction.rs): its mass and density scaled by the ratio of rest densities.
+            var scale = 1.0;
+            if (mobile_i && !mobile_j) {
+                scale = rho0_i / params.phases[phase_j].rho0;
+            }
+            let m_j = params.phases[phase_j].mass * scale;
+            let rho_j = vr_j.w * scale;
             let vdotr = dot(dv, dx);
             drho += m_j * vdotr * f;
             if (!mobile_i) {
@@ -95,7 +101,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 drho += params.delta_h_c0 * 2.0 * (rho_j - rho_i - rho_h) * (-r2 * f) / (r2 + params.eta2) * (m_j / rho_j);
             }
-            let press_j = tait_pressure(rho_j, phase_j) / (rho_j * rho_j);
+            let press_j = tait_pressure(vr_j.w, phase_j) / (rho_j * rho_j);
             var coef = -m_j * (press_i + press_j);
             let mu_ij = h * vdotr / (r2 + params.eta2);
             visc_max = max(visc_max, abs(mu_ij));

@@ -376,8 +376,11 @@ impl Case {
                 "only one sediment phase is supported".into(),
             ));
         }
-        let water: Vec<&PhaseConfig> =
-            self.phases.iter().filter(|p| p.sediment.is_none()).collect();
+        let water: Vec<&PhaseConfig> = self
+            .phases
+            .iter()
+            .filter(|p| p.sediment.is_none())
+            .collect();
         if water.len() != 1 {
             return Err((
                 "phases".into(),

@@ -5,12 +5,12 @@
 
 use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
-use bytemuck::Zeroable;
 use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use crate::gpu::params::*;
 use crate::gpu::{GpuContext, GpuError};
 use crate::observe::{self, Observations};
 use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
+use bytemuck::Zeroable;
 use std::sync::Arc;
 
 #[derive(Debug, thiserror::Error)]

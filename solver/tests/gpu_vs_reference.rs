@@ -401,13 +401,20 @@ fn check_rheology(c: Case, seed: u64) {
         count[(*r & 255) as usize] += 1;
     }
     let mut cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
-    let stress = pass::stress_divergence(&params, &particles.positions, &particles.vel_rho, &rheology);
+    let stress =
+        pass::stress_divergence(&params, &particles.positions, &particles.vel_rho, &rheology);
     for (f, s) in cpu.forces.iter_mut().zip(&stress) {
         for k in 0..3 {
             f[k] += s[k];
         }
     }
-    assert_close("multiphase acceleration", &gpu_forces, &cpu.forces, c.dim(), 1e-4);
+    assert_close(
+        "multiphase acceleration",
+        &gpu_forces,
+        &cpu.forces,
+        c.dim(),
+        1e-4,
+    );
     let h = params.h;
     let cpu_dt = cpu
         .dt_limit
@@ -431,7 +438,11 @@ fn check_rheology(c: Case, seed: u64) {
         c.name
     );
     // Every sediment region this test exists for occurs.
-    let wanted: &[usize] = if model.shields_only { &[1, 3] } else { &[1, 2, 3] };
+    let wanted: &[usize] = if model.shields_only {
+        &[1, 3]
+    } else {
+        &[1, 2, 3]
+    };
     for &r in wanted {
         assert!(count[r] > 0, "no particle in region {r}: {count:?}");
     }

@@ -18,7 +18,7 @@ def main() -> None:
     vertices = [block.data for block in mesh.cells if block.type == "vertex"]
     assert vertices and sum(len(v) for v in vertices) == n, "one vertex cell per particle"
     data = mesh.point_data
-    for name in ("velocity", "density", "phase", "id"):
+    for name in ("velocity", "density", "phase", "region", "held", "id"):
         assert name in data, f"point array {name!r} missing; has {sorted(data)}"
     assert data["velocity"].shape == (n, 3)
     assert np.isfinite(mesh.points).all() and np.isfinite(data["velocity"]).all()

@@ -8,9 +8,16 @@
 use flume_solver::case::Particles;
 use std::io::{self, Write};
 
-/// Writes `particles` as one vertex cell per particle with velocity, density, phase and id.
+/// Writes `particles` as one vertex cell per particle with velocity, density, phase, region,
+/// held flag and id. `regions` are the solver's region words in id order (region 1-5 of the
+/// scour model, 0 for walls, plus 256 when held fixed); missing entries count as 0.
 /// `title` goes on the header's comment line (VTK allows at most 255 characters, no newline).
-pub fn write_particles<W: Write>(mut w: W, title: &str, particles: &Particles) -> io::Result<()> {
+pub fn write_particles<W: Write>(
+    mut w: W,
+    title: &str,
+    particles: &Particles,
+    regions: &[u32],
+) -> io::Result<()> {
     let n = particles.len();
     let count = i32::try_from(n)
         .map_err(|_| io::Error::other("more particles than VTK's 32-bit cell indices hold"))?;
@@ -57,6 +64,17 @@ pub fn write_particles<W: Write>(mut w: W, title: &str, particles: &Particles) -
     for p in &particles.positions {
         // The solver keeps the phase index in w as raw bits; 0 is the wall.
         put_i32s(&mut w, &[p[3].to_bits() as i32])?;
+    }
+    writeln!(w)?;
+    let word = |i: usize| regions.get(i).copied().unwrap_or(0);
+    writeln!(w, "SCALARS region int 1\nLOOKUP_TABLE default")?;
+    for i in 0..n {
+        put_i32s(&mut w, &[(word(i) & 255) as i32])?;
+    }
+    writeln!(w)?;
+    writeln!(w, "SCALARS held int 1\nLOOKUP_TABLE default")?;
+    for i in 0..n {
+        put_i32s(&mut w, &[((word(i) >> 8) & 1) as i32])?;
     }
     writeln!(w)?;
     writeln!(w, "SCALARS id int 1\nLOOKUP_TABLE default")?;
@@ -130,7 +148,7 @@ mod tests {
     #[test]
     fn binary_layout_is_big_endian_legacy_3_0() {
         let mut buf = Vec::new();
-        write_particles(&mut buf, "test t=0.5 s", &two_particles()).unwrap();
+        write_particles(&mut buf, "test t=0.5 s", &two_particles(), &[0, 257]).unwrap();
         let mut b: &[u8] = &buf;
 
         assert_eq!(take_line(&mut b), "# vtk DataFile Version 3.0");
@@ -166,6 +184,16 @@ mod tests {
         assert_eq!(take(&mut b, 8), &[0, 0, 0, 0, 0, 0, 0, 1]);
         assert_eq!(take_line(&mut b), "");
 
+        assert_eq!(take_line(&mut b), "SCALARS region int 1");
+        assert_eq!(take_line(&mut b), "LOOKUP_TABLE default");
+        assert_eq!(be_i32s(take(&mut b, 8)), [0, 1]);
+        assert_eq!(take_line(&mut b), "");
+
+        assert_eq!(take_line(&mut b), "SCALARS held int 1");
+        assert_eq!(take_line(&mut b), "LOOKUP_TABLE default");
+        assert_eq!(be_i32s(take(&mut b, 8)), [0, 1]);
+        assert_eq!(take_line(&mut b), "");
+
         assert_eq!(take_line(&mut b), "SCALARS id int 1");
         assert_eq!(take_line(&mut b), "LOOKUP_TABLE default");
         assert_eq!(be_i32s(take(&mut b, 8)), [0, 1]);
@@ -176,7 +204,7 @@ mod tests {
     #[test]
     fn title_cannot_break_the_header() {
         let mut buf = Vec::new();
-        write_particles(&mut buf, "two\nlines", &Particles::default()).unwrap();
+        write_particles(&mut buf, "two\nlines", &Particles::default(), &[]).unwrap();
         assert!(buf.starts_with(b"# vtk DataFile Version 3.0\ntwolines\nBINARY\n"));
     }
 }
