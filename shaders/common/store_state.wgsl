@@ -4,6 +4,11 @@
 // Mirrors REGION_HELD of shaders/common/sediment.wgsl.
 const REGION_HELD_BIT: u32 = 256u;
 
+// Whether the rheology pass held the particle of this id fixed (`regions` is by id).
+fn is_held(id: u32) -> bool {
+    return (regions[id] & REGION_HELD_BIT) != 0u;
+}
+
 // Raises health flags for a particle's new state.
 fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
     var flags = 0u;
@@ -21,10 +26,9 @@ fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
 
 // Writes particle i's new position x, velocity v and density rho (p, vr: its old state).
 // Walls (DBC) keep their position and velocity, and their density never drops below rho0 so
-// that they never pull fluid in. Held sediment (the rheology pass's REGION_HELD bit in
-// `regions`, which the importing stage declares) keeps its position at rest.
-fn store_state(i: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase) {
-    if (ph.mobile > 0.5 && (regions[i] & REGION_HELD_BIT) != 0u) {
+// that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest.
+fn store_state(i: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase, held: bool) {
+    if (ph.mobile > 0.5 && held) {
         positions_out[i] = p;
         vel_rho_out[i] = vec4<f32>(0.0, 0.0, 0.0, rho);
         check_health(p.xyz, vec3<f32>(0.0), rho, ph.rho0);

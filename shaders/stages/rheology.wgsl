@@ -12,6 +12,7 @@
 @group(0) @binding(5) var stress_a: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(6) var stress_b: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(7) var<storage, read_write> regions: array<u32>;
+@group(0) @binding(8) var<storage, read> ids: array<u32>;
 
 // The predictor's pass runs before dt_update, the corrector's after it; each skips idle steps
 // the way the force pass that follows it does.
@@ -31,7 +32,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (ph_i.mobile < 0.5) {
         textureStore(stress_a, texel(i), vec4<f32>(0.0));
         textureStore(stress_b, texel(i), vec4<f32>(0.0));
-        regions[i] = 0u;
+        regions[ids[i]] = 0u;
         return;
     }
     let sd = params.sediment;
@@ -154,5 +155,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     let t = select(2.0 * mu, 0.0, held) * eps;
     textureStore(stress_a, texel(i), vec4<f32>(t[0].x, t[1].x, t[2].x, t[1].y));
     textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(region)));
-    regions[i] = region | select(0u, REGION_HELD, held);
+    // By particle id: the integrators, the probes and the host each see the particles in a
+    // different order.
+    regions[ids[i]] = region | select(0u, REGION_HELD, held);
 }

@@ -10,6 +10,7 @@
 @group(0) @binding(5) var positions_half: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(6) var vel_rho_half: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(7) var<storage, read> regions: array<u32>;
+@group(0) @binding(8) var<storage, read> ids_n: array<u32>;
 
 // Mirrors REGION_HELD of shaders/common/sediment.wgsl.
 const REGION_HELD_BIT: u32 = 256u;
@@ -27,7 +28,7 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = forces[i];
     let phase = bitcast<u32>(p.w);
     let rho = vr.w + half_dt * f.w;
-    if (params.phases[phase].mobile > 0.5 && (regions[i] & REGION_HELD_BIT) != 0u) {
+    if (params.phases[phase].mobile > 0.5 && (regions[ids_n[i]] & REGION_HELD_BIT) != 0u) {
         textureStore(positions_half, texel(i), p);
         textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, rho));
     } else if (params.phases[phase].mobile > 0.5) {

@@ -54,6 +54,20 @@ pub struct ProfileColumn {
     pub surface_m: Option<f64>,
     /// Top of each phase's layer, in the case's phase order, m; None where the phase is absent.
     pub layer_tops_m: Vec<Option<f64>>,
+    /// The paper's three interfaces, for a case with a sediment phase.
+    pub bed: Option<BedInterfaces>,
+}
+
+/// The interfaces of Zubeldia et al. (2018) Section 3.3 along one vertical line, m, each None
+/// where the column does not hold it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BedInterfaces {
+    /// Moving / immobile grains: the top of the un-yielded (region 1) sediment.
+    pub zb_m: Option<f64>,
+    /// Water / moving grains: the top of the sediment, moving or not.
+    pub zs_m: Option<f64>,
+    /// The free surface.
+    pub zw_m: Option<f64>,
 }
 
 /// A vertical line of sample points from the tank floor to above its top, dp / 2 apart.
@@ -102,10 +116,17 @@ pub struct ProbeLayout {
     profile: Vec<Column>,
     probes: Vec<String>,
     fluid_phases: usize,
+    /// GPU phase index of the sediment, if any.
+    sediment_phase: Option<usize>,
 }
 
-fn total_fullness(s: &[f32; 4]) -> f32 {
-    s[1] + s[2] + s[3]
+/// Fullness of all fluid phases together; with a sediment the third slot is not a phase.
+fn total_fullness(s: &[f32; 4], with_sediment: bool) -> f32 {
+    if with_sediment {
+        s[1] + s[2]
+    } else {
+        s[1] + s[2] + s[3]
+    }
 }
 
 impl ProbeLayout {
@@ -142,6 +163,7 @@ impl ProbeLayout {
             profile,
             probes,
             fluid_phases: case.phases.len(),
+            sediment_phase: case.sediment_phases().map(|(k, _)| k + 1),
         }
     }
 
@@ -153,6 +175,8 @@ impl ProbeLayout {
         sums: &[[f32; 4]],
         ext: &Extremes,
     ) -> Observations {
+        let sediment = self.sediment_phase.is_some();
+        let total = |v: &[f32; 4]| total_fullness(v, sediment);
         let mut rest = sums;
         let mut take = |n: usize| {
             let (head, tail) = rest.split_at(n.min(rest.len()));
@@ -164,7 +188,7 @@ impl ProbeLayout {
             .iter()
             .map(|(name, column)| GaugeReading {
                 name: name.clone(),
-                level_m: column.level(take(column.heights.len()), total_fullness),
+                level_m: column.level(take(column.heights.len()), total),
             })
             .collect();
         let profile = self
@@ -172,12 +196,21 @@ impl ProbeLayout {
             .iter()
             .map(|column| {
                 let s = take(column.heights.len());
+                let surface_m = column.level(s, total);
+                let layer_tops_m: Vec<Option<f64>> = (1..=self.fluid_phases)
+                    .map(|k| column.level(s, |v| v[k]))
+                    .collect();
+                // The probe stage puts the immobile sediment's fullness in the third slot.
+                let bed = self.sediment_phase.map(|k| BedInterfaces {
+                    zb_m: column.level(s, |v| v[3]),
+                    zs_m: layer_tops_m[k - 1],
+                    zw_m: surface_m,
+                });
                 ProfileColumn {
                     x_m: column.position[0],
-                    surface_m: column.level(s, total_fullness),
-                    layer_tops_m: (1..=self.fluid_phases)
-                        .map(|k| column.level(s, |v| v[k]))
-                        .collect(),
+                    surface_m,
+                    layer_tops_m,
+                    bed,
                 }
             })
             .collect();
@@ -188,9 +221,9 @@ impl ProbeLayout {
             .map(|(name, s)| ProbeReading {
                 name: name.clone(),
                 pressure_pa: ProbeSums {
-                    fullness: total_fullness(s),
+                    fullness: total(s),
                     pressure_sum: s[0],
-                    phase_fullness: [0.0, s[1], s[2], s[3]],
+                    phase_fullness: [0.0, s[1], s[2], if sediment { 0.0 } else { s[3] }],
                 }
                 .pressure()
                 .map(f64::from),

@@ -121,8 +121,8 @@ pub struct GpuBuffers {
     /// A copy of `a` taken at the start of each chunk, restored after a blow-up.
     pub snapshot: StateBuffers,
     pub c: StateTextures,
-    /// The rheology pass's viscous stress, (xx, xy, xz, yy) and (yz, zz, mu, region), and
-    /// region words (region | REGION_HELD), in cell order.
+    /// The rheology pass's viscous stress, (xx, xy, xz, yy) and (yz, zz, mu, region), in cell
+    /// order, and region words (region | REGION_HELD) by particle id.
     pub stress_a: wgpu::TextureView,
     pub stress_b: wgpu::TextureView,
     pub regions: wgpu::Buffer,
@@ -365,6 +365,7 @@ impl SphPipeline {
                     &g.stress_a,
                     &g.stress_b,
                     &g.regions,
+                    &g.b_ids,
                 ],
             ),
             rheology_correct: self.rheology_correct.bind(
@@ -378,6 +379,7 @@ impl SphPipeline {
                     &g.stress_a,
                     &g.stress_b,
                     &g.regions,
+                    &g.b_ids,
                 ],
             ),
             dt_update: self.dt_update.bind(d, &[&g.params, &g.state]),
@@ -392,6 +394,7 @@ impl SphPipeline {
                     &g.c.positions,
                     &g.c.vel_rho,
                     &g.regions,
+                    &g.b_ids,
                 ],
             ),
             symplectic_corrector: self.symplectic_corrector.bind(
@@ -436,6 +439,8 @@ impl SphPipeline {
                     &g.cell_starts,
                     &g.probe_points,
                     &g.probe_sums,
+                    &g.b_ids,
+                    &g.regions,
                 ],
             ),
             observe_reduce: self

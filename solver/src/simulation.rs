@@ -527,19 +527,8 @@ impl Simulation {
     /// sediment held fixed in that pass.
     pub fn regions(&self) -> Result<Vec<u32>, SolverError> {
         let n = self.particle_count() as u64;
-        let raw = read_buffers(
-            &self.gpu,
-            &[(&self.buffers.regions, n * 4), (&self.buffers.b_ids, n * 4)],
-        )?;
-        let words: Vec<u32> = cast_vec(&raw[0]);
-        let ids: Vec<u32> = cast_vec(&raw[1]);
-        let mut out = vec![0u32; n as usize];
-        for (&w, &id) in words.iter().zip(&ids) {
-            if let Some(slot) = out.get_mut(id as usize) {
-                *slot = w;
-            }
-        }
-        Ok(out)
+        let raw = read_buffers(&self.gpu, &[(&self.buffers.regions, n * 4)])?;
+        Ok(cast_vec(&raw[0]))
     }
 
     /// Forces and density rates (x, y, z acceleration, d rho/dt) of the current state, in id

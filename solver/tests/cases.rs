@@ -557,7 +557,16 @@ fn a_sand_bed_under_still_water_does_not_creep() {
         for (col, col0) in obs.profile.iter().zip(&start.profile) {
             let top = col.layer_tops_m[1].expect("sand under the column");
             let top0 = col0.layer_tops_m[1].expect("sand under the column");
-            eprintln!("  x={:.3}: bed {top:.4} m (start {top0:.4} m)", col.x_m);
+            let bed = col.bed.expect("a sediment case reports Zb, Zs, Zw");
+            eprintln!(
+                "  x={:.3}: bed {top:.4} m (start {top0:.4} m), Zb {:?} Zs {:?} Zw {:?}",
+                col.x_m, bed.zb_m, bed.zs_m, bed.zw_m
+            );
+            // Nothing moves: the immobile grains reach the top of the sand.
+            let (zb, zs) = (bed.zb_m.expect("Zb"), bed.zs_m.expect("Zs"));
+            assert!((zb - zs).abs() < half_dp, "x={}: Zb {zb} Zs {zs}", col.x_m);
+            assert_eq!(Some(top), bed.zs_m);
+            assert_eq!(col.surface_m, bed.zw_m);
             assert!(
                 (top - top0).abs() < half_dp,
                 "t={t} x={}: the bed surface moved from {top0} to {top} m",
