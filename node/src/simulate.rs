@@ -2,7 +2,7 @@
 
 use crate::cli::SimulateArgs;
 use crate::output::{
-    csv::{GaugeCsv, ProfileCsv},
+    csv::{BedProfileCsv, GaugeCsv, ProfileCsv},
     vtk,
 };
 use crate::table::{Table, sci, sig};
@@ -127,6 +127,8 @@ struct Recorder {
     csv: GaugeCsv<BufWriter<File>>,
     /// profile.csv, when the case asks for a layer profile.
     profile: Option<(PathBuf, ProfileCsv<BufWriter<File>>)>,
+    /// bed_profile.csv, when the case has a sediment and a profile.
+    bed_profile: Option<(PathBuf, BedProfileCsv<BufWriter<File>>)>,
     snapshot_every: Option<u64>,
 }
 
@@ -154,11 +156,23 @@ impl Recorder {
                 Some((path, csv))
             }
         };
+        let bed_profile = match (&obs.profile, case.sediment_phases()) {
+            (Some(_), Some(_)) => {
+                let path = dir.join("bed_profile.csv");
+                let file = File::create(&path)
+                    .with_context(|| format!("cannot create {}", path.display()))?;
+                let csv = BedProfileCsv::new(BufWriter::new(file))
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+                Some((path, csv))
+            }
+            _ => None,
+        };
         Ok(Recorder {
             dir: dir.to_path_buf(),
             csv_path,
             csv,
             profile,
+            bed_profile,
             snapshot_every,
         })
     }
@@ -172,6 +186,10 @@ impl Recorder {
             .row(&obs)
             .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
         if let Some((path, csv)) = &mut self.profile {
+            csv.rows(&obs)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let Some((path, csv)) = &mut self.bed_profile {
             csv.rows(&obs)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }

@@ -110,6 +110,37 @@ impl<W: Write> ProfileCsv<W> {
     }
 }
 
+/// The paper's bed interfaces, one row per column per output interval (long format): time, x,
+/// Zb (moving / immobile grains), Zs (water / moving grains), Zw (free surface), m; a cell is
+/// empty where the column does not hold that interface.
+pub struct BedProfileCsv<W: Write> {
+    w: W,
+}
+
+impl<W: Write> BedProfileCsv<W> {
+    pub fn new(mut w: W) -> io::Result<Self> {
+        writeln!(w, "time_s,x_m,zb_m,zs_m,zw_m")?;
+        w.flush()?;
+        Ok(BedProfileCsv { w })
+    }
+
+    pub fn rows(&mut self, obs: &Observations) -> io::Result<()> {
+        for (col, bed) in obs.profile.iter().filter_map(|c| c.bed.map(|b| (c, b))) {
+            let cell = |v: Option<f64>| v.map_or_else(String::new, |v| (v as f32).to_string());
+            writeln!(
+                self.w,
+                "{},{},{},{},{}",
+                obs.time_s,
+                col.x_m as f32,
+                cell(bed.zb_m),
+                cell(bed.zs_m),
+                cell(bed.zw_m)
+            )?;
+        }
+        self.w.flush()
+    }
+}
+
 /// Quotes a header cell when a gauge name would otherwise break the CSV (RFC 4180).
 fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
@@ -169,6 +200,41 @@ mod tests {
     }
 
     #[test]
+    fn bed_profile_rows_skip_columns_without_interfaces() {
+        let mut buf = Vec::new();
+        let mut csv = BedProfileCsv::new(&mut buf).unwrap();
+        let bed = flume_solver::observe::BedInterfaces {
+            zb_m: Some(0.05),
+            zs_m: Some(0.0625),
+            zw_m: None,
+        };
+        let obs = Observations {
+            time_s: 0.25,
+            steps: 1,
+            dt_s: 1e-4,
+            gauges: vec![],
+            probes: vec![],
+            profile: vec![flume_solver::ProfileColumn {
+                x_m: 1.0,
+                surface_m: None,
+                layer_tops_m: vec![None, Some(0.0625)],
+                bed: Some(bed),
+            }],
+            front_m: None,
+            max_speed_m_per_s: 0.0,
+            max_density_error: 0.0,
+            fluid_particles: 0,
+            recoveries: 0,
+            cfl: 0.2,
+        };
+        csv.rows(&obs).unwrap();
+        assert_eq!(
+            String::from_utf8(buf).unwrap(),
+            "time_s,x_m,zb_m,zs_m,zw_m\n0.25,1,0.05,0.0625,\n"
+        );
+    }
+
+    #[test]
     fn profile_rows_are_long_format_with_empty_cells_for_absent_layers() {
         let mut buf = Vec::new();
         let mut csv =
@@ -184,11 +250,13 @@ mod tests {
                     x_m: 0.25,
                     surface_m: Some(0.1),
                     layer_tops_m: vec![Some(0.1), Some(0.04)],
+                    bed: None,
                 },
                 flume_solver::ProfileColumn {
                     x_m: 0.5,
                     surface_m: None,
                     layer_tops_m: vec![None, Some(0.03)],
+                    bed: None,
                 },
             ],
             front_m: None,
