@@ -38,6 +38,10 @@ pub struct SimulateArgs {
     /// Write no particle snapshots (gauges.csv only).
     #[arg(long, conflicts_with = "snapshot_every")]
     pub no_snapshots: bool,
+    /// Discharge time series for an open flume's inlet: CSV rows `t_s,q_m3_per_s`, each
+    /// discharge held until the next row's time.
+    #[arg(long, value_name = "FILE")]
+    pub inflow: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -57,6 +61,13 @@ pub struct BenchArgs {
         default_value = "launch_configs/dsph_dambreak_val2d.yaml"
     )]
     pub case: PathBuf,
+    /// Open flume timed at its own resolution (the scour model with the inlet running).
+    #[arg(
+        long,
+        value_name = "PATH",
+        default_value = "launch_configs/ulbra_flume.yaml"
+    )]
+    pub flume: PathBuf,
     /// Wall-clock seconds each measurement should last (approximately).
     #[arg(
         long,

@@ -5,6 +5,7 @@
 
 mod bench;
 mod cli;
+mod inflow;
 mod output;
 mod simulate;
 mod table;

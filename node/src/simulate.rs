@@ -1,13 +1,14 @@
 //! `flume-twin simulate`: an offline run of a case, interval by interval.
 
 use crate::cli::SimulateArgs;
+use crate::inflow::InflowSeries;
 use crate::output::{
-    csv::{BedProfileCsv, GaugeCsv, ProfileCsv},
+    csv::{BedProfileCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
     vtk,
 };
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
-use flume_solver::{Case, GpuContext, Observations, Simulation, SolverError};
+use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation, SolverError};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fs::{self, File};
 use std::io::BufWriter;
@@ -33,11 +34,23 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&case.name));
     let snapshot_every = (!args.no_snapshots).then_some(args.snapshot_every);
+    let inflow = match &args.inflow {
+        None => None,
+        Some(path) if case.open_flume.is_none() => bail!(
+            "--inflow {}: the case {} has no open_flume to feed",
+            path.display(),
+            case.name
+        ),
+        Some(path) => Some(InflowSeries::from_path(path)?),
+    };
 
     let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
     println!("adapter: {}", gpu.adapter);
     let mut sim = Simulation::new(gpu, &case).context("cannot set up the simulation")?;
     print_case(&args.case, &case, &sim);
+    if let Some(series) = &inflow {
+        set_inflow(&mut sim, series, 0.0)?;
+    }
 
     let mut recorder = Recorder::create(&out_dir, &case, snapshot_every)?;
     let interval_s = case.time.output_interval_s;
@@ -59,19 +72,22 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut last = recorder.record(&sim, 0)?;
     for k in 1..=intervals {
         let target_s = (k as f64 * interval_s).min(end_s);
-        if let Err(err) = sim.advance_to(target_s) {
+        if let Err(err) = advance(&mut sim, inflow.as_ref(), target_s) {
             progress.abandon();
-            if matches!(err, SolverError::BlowUp { .. }) {
+            if matches!(
+                err.downcast_ref::<SolverError>(),
+                Some(SolverError::BlowUp { .. })
+            ) {
                 // The broken state shows where it went wrong; losing it would waste the run.
                 if let Err(e) = recorder.snapshot(&sim, "particles_failed.vtk") {
                     log::warn!("could not write the failed state: {e:#}");
                 }
             }
-            return Err(err).context(format!(
+            return Err(err.context(format!(
                 "the simulation stopped; outputs up to t = {} s are in {}",
                 last.time_s,
                 out_dir.display()
-            ));
+            )));
         }
         last = recorder.record(&sim, k)?;
         let wall = started.elapsed().as_secs_f64();
@@ -86,6 +102,32 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let wall_s = started.elapsed().as_secs_f64();
     print_summary(&sim, &last, wall_s);
     Ok(())
+}
+
+/// Advances to `target_s`, stopping at each change of the inflow series on the way to apply it
+/// at its own time.
+fn advance(
+    sim: &mut Simulation,
+    inflow: Option<&InflowSeries>,
+    target_s: f64,
+) -> Result<(), anyhow::Error> {
+    if let Some(series) = inflow {
+        for t in series.changes_between(sim.time_s(), target_s) {
+            sim.advance_to(t)?;
+            set_inflow(sim, series, t)?;
+        }
+    }
+    sim.advance_to(target_s)?;
+    if let Some(series) = inflow {
+        set_inflow(sim, series, target_s)?;
+    }
+    Ok(())
+}
+
+fn set_inflow(sim: &mut Simulation, series: &InflowSeries, t_s: f64) -> Result<()> {
+    let q = series.discharge_at(t_s);
+    sim.set_boundary_conditions(BoundaryConditions { inflow_m3_per_s: q })
+        .with_context(|| format!("the inflow series' discharge {q} m3/s at t = {t_s} s"))
 }
 
 fn print_case(path: &Path, case: &Case, sim: &Simulation) {
@@ -119,6 +161,19 @@ fn progress_bar(end_s: f64) -> ProgressBar {
     bar
 }
 
+/// Creates `dir/name` and writes its header with `start`.
+fn create_csv<T>(
+    dir: &Path,
+    name: &str,
+    start: impl FnOnce(BufWriter<File>) -> std::io::Result<T>,
+) -> Result<(PathBuf, T)> {
+    let path = dir.join(name);
+    let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+    let csv =
+        start(BufWriter::new(file)).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok((path, csv))
+}
+
 /// The files of a run: gauges.csv gets a row per output interval, and every
 /// `snapshot_every`-th interval k a snapshot `particles_kkkk.vtk`.
 struct Recorder {
@@ -129,6 +184,8 @@ struct Recorder {
     profile: Option<(PathBuf, ProfileCsv<BufWriter<File>>)>,
     /// bed_profile.csv, when the case has a sediment and a profile.
     bed_profile: Option<(PathBuf, BedProfileCsv<BufWriter<File>>)>,
+    /// eroded_mass.csv, for an open flume.
+    eroded: Option<(PathBuf, ErodedMassCsv<BufWriter<File>>)>,
     snapshot_every: Option<u64>,
 }
 
@@ -147,25 +204,19 @@ impl Recorder {
         let profile = match &obs.profile {
             None => None,
             Some(_) => {
-                let path = dir.join("profile.csv");
                 let phases: Vec<String> = case.phases.iter().map(|p| p.name.clone()).collect();
-                let file = File::create(&path)
-                    .with_context(|| format!("cannot create {}", path.display()))?;
-                let csv = ProfileCsv::new(BufWriter::new(file), &phases)
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-                Some((path, csv))
+                Some(create_csv(dir, "profile.csv", |w| {
+                    ProfileCsv::new(w, &phases)
+                })?)
             }
         };
         let bed_profile = match (&obs.profile, case.sediment_phases()) {
-            (Some(_), Some(_)) => {
-                let path = dir.join("bed_profile.csv");
-                let file = File::create(&path)
-                    .with_context(|| format!("cannot create {}", path.display()))?;
-                let csv = BedProfileCsv::new(BufWriter::new(file))
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-                Some((path, csv))
-            }
+            (Some(_), Some(_)) => Some(create_csv(dir, "bed_profile.csv", BedProfileCsv::new)?),
             _ => None,
+        };
+        let eroded = match &case.open_flume {
+            Some(_) => Some(create_csv(dir, "eroded_mass.csv", ErodedMassCsv::new)?),
+            None => None,
         };
         Ok(Recorder {
             dir: dir.to_path_buf(),
@@ -173,6 +224,7 @@ impl Recorder {
             csv,
             profile,
             bed_profile,
+            eroded,
             snapshot_every,
         })
     }
@@ -191,6 +243,10 @@ impl Recorder {
         }
         if let Some((path, csv)) = &mut self.bed_profile {
             csv.rows(&obs)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let Some((path, csv)) = &mut self.eroded {
+            csv.row(&obs)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
         if self.snapshot_every.is_some_and(|n| k.is_multiple_of(n)) {

@@ -32,6 +32,26 @@ struct Sediment {
     pad1: f32,
 }
 
+// The open flume (2-D); enabled == 0 for a closed tank.
+struct Flume {
+    enabled: u32,
+    water_phase: u32,
+    parked_phase: u32,       // phase of parked particles (out of the flow, never interacting)
+    parking_cols: u32,       // parking spots per row
+    inlet_x_face: f32,       // water with x below this, in the opening, is the inlet buffer, m
+    inlet_y_min: f32,        // the opening, m (y_min < y <= y_max; the buffer's lattice rows
+    inlet_y_max: f32,        // lie strictly inside it)
+    inlet_u: f32,            // inlet velocity, m/s: Q / (opening height x flume width)
+    outlet_x: f32,           // fluid past this x has left over the weir, m
+    collector_x_min: f32,    // sediment in this box is eroded, m
+    collector_x_max: f32,
+    collector_y_max: f32,
+    parking_x0: f32,         // spot of particle id k: x0 + (k % cols) dp, y0 + (k / cols) dp
+    parking_y0: f32,
+    parking_dp: f32,
+    pad: f32,
+}
+
 struct SimParams {
     n_particles: u32,
     n_cells: u32,
@@ -53,12 +73,13 @@ struct SimParams {
     vertical_axis: u32,      // 1 in 2-D (y up), 2 in 3-D (z up)
     n_probes: u32,
     euler_every: u32,        // Verlet: an Euler step every this many steps
-    pad0: u32,
+    clamp_pressure: u32,     // 1: no tension: fluid density floored at rest, pressure >= 0
     pad1: u32,
     pad2: u32,
     phases: array<Phase, 4>,
     tait_b: vec4<f32>,       // c0^2 rho0 / 7 per phase
     sediment: Sediment,
+    flume: Flume,
 }
 
 @group(0) @binding(0) var<uniform> params: SimParams;

@@ -13,8 +13,8 @@ struct StepState {
     step_base: u32,             // steps taken before this chunk, modulo the Verlet Euler period
     dt_prev: f32,               // the step before the one being taken, s (Verlet's leapfrog span)
     dt_taken: f32,              // the last step actually taken, s
-    pad0: u32,
-    pad1: u32,
+    eroded: atomic<u32>,        // sediment particles collected in this chunk (open flume)
+    parked: atomic<u32>,        // particles parked in this chunk (open flume)
 }
 
 const STATUS_NON_FINITE: u32 = 1u;

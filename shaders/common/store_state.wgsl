@@ -24,18 +24,72 @@ fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
     }
 }
 
-// Writes particle i's new position x, velocity v and density rho (p, vr: its old state).
-// Walls (DBC) keep their position and velocity, and their density never drops below rho0 so
-// that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest.
-fn store_state(i: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase, held: bool) {
-    if (ph.mobile > 0.5 && held) {
+// Whether a particle at `x` is in the inlet buffer, whose velocity is imposed: behind the
+// buffer's face, in the opening. Water that wanders in is pushed out with the buffer.
+fn in_inlet(x: vec3<f32>) -> bool {
+    let f = params.flume;
+    return f.enabled != 0u && x.x < f.inlet_x_face && x.y > f.inlet_y_min && x.y <= f.inlet_y_max;
+}
+
+// Parks particle i (id `id`) at its spot as water; counts it as eroded when it was sediment
+// (that reached the collector, or left over the weir).
+fn park(i: u32, id: u32, eroded: bool) {
+    let f = params.flume;
+    let spot = vec2<f32>(
+        f.parking_x0 + f32(id % f.parking_cols) * f.parking_dp,
+        f.parking_y0 + f32(id / f.parking_cols) * f.parking_dp,
+    );
+    positions_out[i] = vec4<f32>(spot, 0.0, bitcast<f32>(f.parked_phase));
+    vel_rho_out[i] = vec4<f32>(0.0, 0.0, 0.0, params.phases[f.parked_phase].rho0);
+    atomicAdd(&state.parked, 1u);
+    if (eroded) {
+        atomicAdd(&state.eroded, 1u);
+    }
+}
+
+// Writes particle i's (id `id`) new position x, velocity v and density rho (p, vr: its old
+// state). Walls (DBC) keep their position and velocity, and their density never drops below
+// rho0 so that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest.
+// In an open flume: parked particles stay parked; fluid past the outlet and sediment in the
+// collector are parked; the inlet buffer moves at the inlet velocity, at its density.
+fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase) {
+    let phase = bitcast<u32>(p.w);
+    let f = params.flume;
+    if (f.enabled != 0u && ph.mobile > 0.5) {
+        let sediment = params.sediment.phase;
+        if (x.x > f.outlet_x) {
+            park(i, id, sediment != 0u && phase == sediment);
+            return;
+        }
+        if (sediment != 0u && phase == sediment && x.x >= f.collector_x_min && x.x <= f.collector_x_max && x.y < f.collector_y_max) {
+            park(i, id, true);
+            return;
+        }
+        if (phase == f.water_phase && in_inlet(p.xyz)) {
+            // Imposed velocity, and the density it entered with: a buffer column drawing away
+            // from the wall behind it would otherwise thin out until the next one enters.
+            let u = vec3<f32>(f.inlet_u, 0.0, 0.0);
+            let moved = p.xyz + state.dt * u;
+            positions_out[i] = vec4<f32>(moved, p.w);
+            vel_rho_out[i] = vec4<f32>(u, vr.w);
+            check_health(moved, u, vr.w, ph.rho0);
+            return;
+        }
+    }
+    if (ph.mobile > 0.5 && is_held(id)) {
         positions_out[i] = p;
         vel_rho_out[i] = vec4<f32>(0.0, 0.0, 0.0, rho);
         check_health(p.xyz, vec3<f32>(0.0), rho, ph.rho0);
     } else if (ph.mobile > 0.5) {
+        // Without tension (the case's clamp_negative_pressure) the density never falls below
+        // rest: a sheet too thin for a full kernel would otherwise thin out without end.
+        let r = select(rho, max(rho, ph.rho0), params.clamp_pressure != 0u);
         positions_out[i] = vec4<f32>(x, p.w);
-        vel_rho_out[i] = vec4<f32>(v, rho);
-        check_health(x, v, rho, ph.rho0);
+        vel_rho_out[i] = vec4<f32>(v, r);
+        check_health(x, v, r, ph.rho0);
+    } else if (f.enabled != 0u && phase == f.parked_phase) {
+        positions_out[i] = p;
+        vel_rho_out[i] = vr;
     } else {
         positions_out[i] = p;
         vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));

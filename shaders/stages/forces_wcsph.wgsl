@@ -16,6 +16,12 @@
 
 const VISCOSITY_MULTIPHASE: u32 = 2u;
 
+// The pressure of the momentum equation: Tait's, without tension when the case says so.
+fn momentum_pressure(rho: f32, phase: u32) -> f32 {
+    let p = tait_pressure(rho, phase);
+    return select(p, max(p, 0.0), params.clamp_pressure != 0u);
+}
+
 // A particle's viscous stress over rho^2 from the rheology pass's (xx, xy, xz, yy) and
 // (yz, zz, mu, region) texels.
 fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
@@ -39,9 +45,16 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pos_i = textureLoad(positions, texel(i), 0);
     let vr_i = textureLoad(vel_rho, texel(i), 0);
     let phase_i = bitcast<u32>(pos_i.w);
+    // Parked particles (open flume) take no part; nothing moves them.
+    let parked = params.flume.parked_phase;
+    let flume = params.flume.enabled != 0u;
+    if (flume && phase_i == parked) {
+        forces[i] = vec4<f32>(0.0);
+        return;
+    }
     let mobile_i = params.phases[phase_i].mobile > 0.5;
     let rho_i = vr_i.w;
-    let press_i = tait_pressure(rho_i, phase_i) / (rho_i * rho_i);
+    let press_i = momentum_pressure(rho_i, phase_i) / (rho_i * rho_i);
     let h = params.h;
     let four_h2 = 4.0 * h * h;
     let r2_min = 1e-12 * h * h;
@@ -71,7 +84,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let phase_j = bitcast<u32>(pos_j.w);
             let mobile_j = params.phases[phase_j].mobile > 0.5;
-            if (!mobile_i && !mobile_j) {
+            if ((!mobile_i && !mobile_j) || (flume && phase_j == parked)) {
                 continue;
             }
             let vr_j = textureLoad(vel_rho, texel(j), 0);
@@ -101,7 +114,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 drho += params.delta_h_c0 * 2.0 * (rho_j - rho_i - rho_h) * (-r2 * f) / (r2 + params.eta2) * (m_j / rho_j);
             }
-            let press_j = tait_pressure(vr_j.w, phase_j) / (rho_j * rho_j);
+            let press_j = momentum_pressure(vr_j.w, phase_j) / (rho_j * rho_j);
             var coef = -m_j * (press_i + press_j);
             let mu_ij = h * vdotr / (r2 + params.eta2);
             visc_max = max(visc_max, abs(mu_ij));
@@ -112,6 +125,10 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 acc += coef * f * dx;
             } else if (multiphase) {
+                if (vdotr < 0.0) {
+                    let pi_ij = -params.alpha * params.c0 * mu_ij / (0.5 * (rho_i + rho_j));
+                    coef -= m_j * pi_ij;
+                }
                 var tau = tau_i;
                 if (mobile_j) {
                     tau += stress_over_rho2(j, rho_j);

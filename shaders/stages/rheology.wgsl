@@ -67,6 +67,9 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let phase_j = bitcast<u32>(pos_j.w);
+            if (params.flume.enabled != 0u && phase_j == params.flume.parked_phase) {
+                continue;
+            }
             let vr_j = textureLoad(vel_rho, texel(j), 0);
             let m_j = params.phases[phase_j].mass;
             let v_j = m_j / vr_j.w;

@@ -32,5 +32,5 @@ fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rho = vr.w * (2.0 - eps) / (2.0 + eps);
     ids_out[i] = ids_n[i];
     let v = vr.xyz + dt * f.xyz;
-    store_state(i, p, vr, p.xyz + dt * 0.5 * (vr.xyz + v), v, rho, ph, is_held(ids_n[i]));
+    store_state(i, ids_n[i], p, vr, p.xyz + dt * 0.5 * (vr.xyz + v), v, rho, ph);
 }

@@ -1,7 +1,8 @@
 // Symplectic position-Verlet integration as in DualSPHysics, first half step:
 // x(n+1/2) = x(n) + dt/2 v(n), v(n+1/2) = v(n) + dt/2 a(n), rho(n+1/2) = rho(n) + dt/2 drho(n).
 // Walls (DBC) keep position and velocity; their density never drops below rho0 so that they
-// never pull fluid in; held sediment stays at rest. Reference: solver/src/physics/integrate.rs.
+// never pull fluid in; held sediment stays at rest; an open flume's parked particles stay
+// parked and its inlet buffer moves at the inlet velocity. Reference: solver/src/physics/integrate.rs.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
 @group(0) @binding(2) var<storage, read> forces: array<vec4<f32>>;
@@ -28,12 +29,22 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = forces[i];
     let phase = bitcast<u32>(p.w);
     let rho = vr.w + half_dt * f.w;
-    if (params.phases[phase].mobile > 0.5 && (regions[ids_n[i]] & REGION_HELD_BIT) != 0u) {
+    let fl = params.flume;
+    if (fl.enabled != 0u && phase == fl.parked_phase) {
+        textureStore(positions_half, texel(i), p);
+        textureStore(vel_rho_half, texel(i), vr);
+    } else if (fl.enabled != 0u && phase == fl.water_phase && p.x < fl.inlet_x_face && p.y > fl.inlet_y_min && p.y <= fl.inlet_y_max) {
+        // The inlet buffer moves at the inlet velocity, at its density (store_state.wgsl).
+        let u = vec3<f32>(fl.inlet_u, 0.0, 0.0);
+        textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * u, p.w));
+        textureStore(vel_rho_half, texel(i), vec4<f32>(u, vr.w));
+    } else if (params.phases[phase].mobile > 0.5 && (regions[ids_n[i]] & REGION_HELD_BIT) != 0u) {
         textureStore(positions_half, texel(i), p);
         textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, rho));
     } else if (params.phases[phase].mobile > 0.5) {
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * vr.xyz, p.w));
-        textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz + half_dt * f.xyz, rho));
+        let r = select(rho, max(rho, params.phases[phase].rho0), params.clamp_pressure != 0u);
+        textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz + half_dt * f.xyz, r));
     } else {
         textureStore(positions_half, texel(i), p);
         textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz, max(rho, params.phases[phase].rho0)));

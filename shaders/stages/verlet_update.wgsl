@@ -44,5 +44,5 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     ids_out[i] = ids_n[i];
     vel_rho_prev_out[i] = vr;
     let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
-    store_state(i, p, vr, x, base.xyz + span * f.xyz, rho, ph, is_held(ids_n[i]));
+    store_state(i, ids_n[i], p, vr, x, base.xyz + span * f.xyz, rho, ph);
 }

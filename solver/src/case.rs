@@ -10,6 +10,53 @@ use std::collections::HashSet;
 /// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
 pub const WALL_PHASE: u32 = 0;
 
+/// GPU phase index of parked particles in an open flume: the one after the case's phases.
+pub fn parked_phase(case: &Case) -> u32 {
+    case.phases.len() as u32 + 1
+}
+
+/// Where parked particles wait in an open flume: a lattice of spots dp apart above the flume,
+/// one per particle id, clear of the splash room above the walls by 4h, so that no parked
+/// particle comes within a kernel support of the flow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Parking {
+    pub x0: f64,
+    pub y0: f64,
+    pub cols: u32,
+    pub dp: f64,
+}
+
+impl Parking {
+    pub fn new(case: &Case, h: f64) -> Parking {
+        let dp = case.numerics.dp_m;
+        let (lo, hi) = (&case.domain.min_m, &case.domain.max_m);
+        let height = hi[1] - lo[1];
+        Parking {
+            x0: lo[0] + 0.5 * dp,
+            y0: hi[1] + SPLASH_ROOM * height + 4.0 * h,
+            cols: ((hi[0] - lo[0]) / dp).floor().max(1.0) as u32,
+            dp,
+        }
+    }
+
+    /// The spot of particle `id`, m.
+    pub fn spot(&self, id: u32) -> [f32; 2] {
+        [
+            (self.x0 + f64::from(id % self.cols) * self.dp) as f32,
+            (self.y0 + f64::from(id / self.cols) * self.dp) as f32,
+        ]
+    }
+
+    /// Top of the spots of `n` particles, m.
+    pub fn top(&self, n: u64) -> f64 {
+        self.y0 + (n / u64::from(self.cols) + 1) as f64 * self.dp
+    }
+}
+
+/// Room kept above a tank for splashes, as a fraction of its height (the neighbour grid covers
+/// it; particles above the grid still live in its top row).
+pub const SPLASH_ROOM: f64 = 0.25;
+
 /// Particle state on the CPU, in the GPU's layout (see `gpu::params`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Particles {
@@ -109,6 +156,14 @@ fn is_wall(case: &Case, p: &[i64], lo: &[i64], hi: &[i64]) -> bool {
             outside_or_on = true;
         }
     }
+    // An open flume's downstream wall stops at the weir; the floor under it stays.
+    if let Some(f) = &case.open_flume
+        && p[0] >= hi[0]
+        && p[vert] > lo[vert]
+        && p[vert] as f64 * case.numerics.dp_m > f.outlet_weir_m + 1e-9
+    {
+        return false;
+    }
     outside_or_on
 }
 
@@ -138,7 +193,8 @@ fn block_bounds(case: &Case, min: &[f64], max: &[f64]) -> (Vec<i64>, Vec<i64>) {
     (lo, hi)
 }
 
-/// Generates the particles of a case, walls first, then fluid blocks in file order.
+/// Generates the particles of a case: walls, wall blocks, then fluid blocks in file order
+/// (and, in an open flume, the inlet buffer and the parked reservoir).
 pub fn generate(case: &Case, derived: &Derived) -> Particles {
     let dp = case.numerics.dp_m;
     let d = case.dim();
@@ -160,21 +216,32 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
     let wall = derived.phases[WALL_PHASE as usize];
     let wall_b = tait_b(derived.c0, wall.rho0);
     let reach = f64::from(case.walls.layers) * dp + 1e-9;
+    // Walls under fluid start at the hydrostatic density of what lies above them, so that the
+    // fluid does not first sink into walls at rest density.
+    let push_wall = |p: &[i64], out: &mut Particles| {
+        let x: Vec<f64> = p.iter().map(|v| *v as f64 * dp).collect();
+        let pressure = hydrostatic_pressure(case, &x, reach, gravity);
+        push(
+            p,
+            WALL_PHASE,
+            tait_density(wall.rho0, wall_b, pressure),
+            out,
+        );
+    };
     for_each_point(&wlo, &whi, |p| {
         if is_wall(case, p, &lo, &hi) {
             taken.insert(p.to_vec());
-            // Walls under fluid start at the hydrostatic density of what lies above them, so
-            // that the fluid does not first sink into walls at rest density.
-            let x: Vec<f64> = p.iter().map(|v| *v as f64 * dp).collect();
-            let pressure = hydrostatic_pressure(case, &x, reach, gravity);
-            push(
-                p,
-                WALL_PHASE,
-                tait_density(wall.rho0, wall_b, pressure),
-                &mut out,
-            );
+            push_wall(p, &mut out);
         }
     });
+    for block in &case.walls.blocks {
+        let (blo, bhi) = block_bounds(case, &block.min_m, &block.max_m);
+        for_each_point(&blo, &bhi, |p| {
+            if taken.insert(p.to_vec()) {
+                push_wall(p, &mut out);
+            }
+        });
+    }
     for block in &case.fluid_blocks {
         let Some(k) = case.phase_index(&block.phase) else {
             continue;
@@ -192,7 +259,46 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
             }
         });
     }
+    if let Some(f) = &case.open_flume {
+        let water = 1 + case.sediment_phases().map_or(0, |(_, w)| w) as u32;
+        let rho0 = derived.phases[water as usize].rho0;
+        for p in inlet_points(case, f) {
+            if taken.insert(p.clone()) {
+                push(&p, water, rho0, &mut out);
+            }
+        }
+        let parking = Parking::new(case, derived.h);
+        let parked = parked_phase(case);
+        for _ in 0..f.reservoir_particles {
+            let id = out.positions.len() as u32;
+            let [x, y] = parking.spot(id);
+            out.ids.push(id);
+            out.positions.push([x, y, 0.0, f32::from_bits(parked)]);
+            out.vel_rho.push([0.0, 0.0, 0.0, rho0 as f32]);
+        }
+    }
     out
+}
+
+/// Lattice points of the inlet buffer at the start: `layers` columns next to the upstream
+/// wall, over the opening's height (block semantics: `y_min < y <= y_min + height`).
+fn inlet_points(case: &Case, f: &crate::config::OpenFlume) -> Vec<Vec<i64>> {
+    let (lo, _) = lattice_bounds(case);
+    let dp = case.numerics.dp_m;
+    let (ylo, yhi) = block_bounds(
+        case,
+        &[f.inlet.y_min_m],
+        &[f.inlet.y_min_m + f.inlet.height_m],
+    );
+    let mut points = Vec::new();
+    for i in 1..=i64::from(f.inlet.layers) {
+        for j in ylo[0]..=yhi[0] {
+            if (j as f64) * dp > case.domain.min_m[1] {
+                points.push(vec![lo[0] + i, j]);
+            }
+        }
+    }
+    points
 }
 
 /// Pressure at `x` of the fluid blocks above it at rest, Pa: each block whose horizontal
@@ -253,12 +359,17 @@ pub fn count(case: &Case) -> u64 {
         })
         .collect();
     let mut n = boxes(&wlo, &whi) - boxes(&inner_lo, &inner_hi);
-    // Fluid blocks: an upper bound when blocks overlap, exact otherwise; it only guards limits.
-    for block in &case.fluid_blocks {
-        let (blo, bhi) = block_bounds(case, &block.min_m, &block.max_m);
+    // Wall and fluid blocks: an upper bound when blocks overlap, exact otherwise; it only
+    // guards limits.
+    let blocks = case.walls.blocks.iter().map(|b| (&b.min_m, &b.max_m));
+    for (min, max) in blocks.chain(case.fluid_blocks.iter().map(|b| (&b.min_m, &b.max_m))) {
+        let (blo, bhi) = block_bounds(case, min, max);
         let clo: Vec<i64> = blo.iter().zip(&inner_lo).map(|(a, b)| *a.max(b)).collect();
         let chi: Vec<i64> = bhi.iter().zip(&inner_hi).map(|(a, b)| *a.min(b)).collect();
         n += boxes(&clo, &chi);
+    }
+    if let Some(f) = &case.open_flume {
+        n += inlet_points(case, f).len() as u64 + u64::from(f.reservoir_particles);
     }
     n
 }
@@ -305,6 +416,14 @@ pub fn derive(case: &Case) -> Derived {
         viscosity_pa_s: p.viscosity_pa_s,
         mobile: true,
     }));
+    if case.open_flume.is_some() {
+        // Parked particles are water waiting out of the flow.
+        let water = 1 + case.sediment_phases().map_or(0, |(_, w)| w);
+        phases.push(PhaseProps {
+            mobile: false,
+            ..phases[water]
+        });
+    }
     Derived {
         h: case.smoothing_length_m(),
         c0,

@@ -50,6 +50,57 @@ pub struct Case {
     pub time: TimeControl,
     #[serde(default)]
     pub observations: ObservationConfig,
+    /// Inlet, outlet and sediment collector of an open flume (2-D); absent for a closed tank.
+    #[serde(default)]
+    pub open_flume: Option<OpenFlume>,
+}
+
+/// An open flume (2-D). Water enters through an inlet at the upstream (x-min) wall, whose
+/// velocity follows the discharge, leaves over the downstream (x-max) wall's weir, and sediment
+/// reaching the collector is counted as eroded (Eq. 34) and recycled as water. The particle
+/// count never changes: particles that leave are parked out of the flow, and the inlet draws
+/// on the parked ones, lowest id first.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OpenFlume {
+    /// Width of the flume across the 2-D plane, m: the discharge Q becomes the inlet velocity
+    /// Q / (inlet height x width), and the eroded mass per metre times the width is in kg.
+    pub width_m: f64,
+    /// Discharge at the start, m3/s (changed at run time with `Simulation::set_boundary_conditions`).
+    #[serde(default)]
+    pub inflow_m3_per_s: f64,
+    pub inlet: InletConfig,
+    /// Height of the downstream wall, m: fluid that flows over it and past it leaves the flume.
+    pub outlet_weir_m: f64,
+    /// Sediment entering this box is eroded: counted, and recycled as water.
+    pub collector: CollectorConfig,
+    /// Water particles parked at the start, for the inlet to draw on before any has left.
+    pub reservoir_particles: u32,
+}
+
+/// The inlet: an opening in the upstream wall from `y_min_m` to `y_min_m + height_m`, fed by a
+/// buffer of `layers` columns of water particles next to the wall that move at the inlet
+/// velocity; a new column enters behind them each time they have moved one dp.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InletConfig {
+    pub y_min_m: f64,
+    pub height_m: f64,
+    #[serde(default = "default_inlet_layers")]
+    pub layers: u32,
+}
+
+fn default_inlet_layers() -> u32 {
+    4
+}
+
+/// A box, m: x from `x_min_m` to `x_max_m`, below `y_max_m`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CollectorConfig {
+    pub x_min_m: f64,
+    pub x_max_m: f64,
+    pub y_max_m: f64,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -68,6 +119,18 @@ pub struct Walls {
     /// Whether the top of the tank is closed by a wall too.
     #[serde(default)]
     pub closed_top: bool,
+    /// Solid blocks inside the tank, filled with wall particles on the dp lattice like fluid
+    /// blocks (a fixed apron under an inlet, a step, an obstacle).
+    #[serde(default)]
+    pub blocks: Vec<WallBlock>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallBlock {
+    /// Lattice points with `min_m < x <= max_m` in every coordinate are wall.
+    pub min_m: Vec<f64>,
+    pub max_m: Vec<f64>,
 }
 
 fn one() -> u32 {
@@ -168,6 +231,13 @@ pub struct Numerics {
     /// Time integration; symplectic when omitted.
     #[serde(default)]
     pub integrator: Integrator,
+    /// No tension: fluid densities never fall below rest and negative pressures count as zero
+    /// in the momentum equation. A thin sheet of water (the flume's jet before the bed is wet)
+    /// has too few neighbours, its density falls below rest, and the tension pulls its
+    /// particles into clumps that then collide (the tensile instability); water does not
+    /// sustain that tension anyway. Off by default.
+    #[serde(default)]
+    pub clamp_negative_pressure: bool,
 }
 
 /// Time integration scheme (both as in DualSPHysics).
@@ -222,8 +292,14 @@ pub enum Viscosity {
     /// Laminar viscosity (Morris et al. 1997) with each phase's `viscosity_pa_s`.
     Laminar,
     /// The viscous stress tau = 2 mu eps of Eqs. 10-11 and 14 from each particle's strain rate,
-    /// mu the water's viscosity or, for sediment, the apparent viscosity of its region.
-    Multiphase,
+    /// mu the water's viscosity or, for sediment, the apparent viscosity of its region; plus,
+    /// with `alpha` > 0, Monaghan's artificial viscosity on every pair. Water's own viscosity
+    /// does nothing at these resolutions, and a thin sheet of water then clumps into pairs
+    /// that collide (the flume's front over the dry bed did at dp = 1 cm).
+    Multiphase {
+        #[serde(default)]
+        alpha: f64,
+    },
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -393,7 +469,7 @@ impl Case {
                 "a sediment must be denser than the water".into(),
             ));
         }
-        if !matches!(self.numerics.viscosity, Viscosity::Multiphase) {
+        if !matches!(self.numerics.viscosity, Viscosity::Multiphase { .. }) {
             return Err((
                 "numerics.viscosity.method".into(),
                 "a sediment phase needs `multiphase`".into(),
@@ -428,6 +504,73 @@ impl Case {
             && !positive(mu)
         {
             return err("max_viscosity_pa_s", "must be positive");
+        }
+        Ok(())
+    }
+
+    fn validate_open_flume(&self, f: &OpenFlume) -> Result<(), (String, String)> {
+        let err = |name: &str, reason: String| Err((format!("open_flume.{name}"), reason));
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if self.dimension != 2 {
+            return err("", "an open flume is 2-D only for now".into());
+        }
+        if self.phases.len() > 2 {
+            return err(
+                "",
+                "an open flume takes at most two phases (water and a sediment)".into(),
+            );
+        }
+        if !positive(f.width_m) {
+            return err("width_m", "must be positive".into());
+        }
+        if !(f.inflow_m3_per_s.is_finite() && f.inflow_m3_per_s >= 0.0) {
+            return err("inflow_m3_per_s", "must be >= 0".into());
+        }
+        let (lo, hi) = (&self.domain.min_m, &self.domain.max_m);
+        let dp = self.numerics.dp_m;
+        if !(positive(f.inlet.height_m) && f.inlet.height_m >= dp) {
+            return err("inlet.height_m", "must be at least dp".into());
+        }
+        if !(f.inlet.y_min_m >= lo[1] && f.inlet.y_min_m + f.inlet.height_m <= hi[1]) {
+            return err(
+                "inlet.y_min_m",
+                "the inlet must lie within the domain's height".into(),
+            );
+        }
+        if !(2..=16).contains(&f.inlet.layers) {
+            return err(
+                "inlet.layers",
+                format!("must be 2..=16, got {}", f.inlet.layers),
+            );
+        }
+        if !(f.outlet_weir_m > lo[1] && f.outlet_weir_m <= hi[1]) {
+            return err(
+                "outlet_weir_m",
+                "must lie within the domain's height".into(),
+            );
+        }
+        let c = &f.collector;
+        if !(c.x_min_m < c.x_max_m && c.x_min_m >= lo[0] && c.x_max_m <= hi[0] && c.y_max_m > lo[1])
+        {
+            return err(
+                "collector",
+                "must be a box inside the flume (x_min < x_max, above the floor)".into(),
+            );
+        }
+        // Sediment that starts in the collector would count as eroded at the first step.
+        if let Some((k, _)) = self.sediment_phases() {
+            let name = &self.phases[k].name;
+            for b in self.fluid_blocks.iter().filter(|b| &b.phase == name) {
+                if b.max_m[0] >= c.x_min_m && b.min_m[0] < c.x_max_m && b.min_m[1] < c.y_max_m {
+                    return err(
+                        "collector.x_min_m",
+                        format!(
+                            "the {name} block ending at x = {} m reaches into the collector",
+                            b.max_m[0]
+                        ),
+                    );
+                }
+            }
         }
         Ok(())
     }
@@ -469,6 +612,10 @@ impl Case {
                 "walls.layers",
                 format!("must be 1..=8, got {}", self.walls.layers),
             );
+        }
+        for (i, b) in self.walls.blocks.iter().enumerate() {
+            check_vector(&format!("walls.blocks[{i}].min_m"), &b.min_m, d)?;
+            check_vector(&format!("walls.blocks[{i}].max_m"), &b.max_m, d)?;
         }
         if self.phases.is_empty() {
             return err("phases", "at least one phase is needed".to_string());
@@ -586,7 +733,7 @@ impl Case {
             }
             _ => {}
         }
-        if let Viscosity::Artificial { alpha } = n.viscosity
+        if let Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } = n.viscosity
             && !(alpha.is_finite() && (0.0..=10.0).contains(&alpha))
         {
             return err(
@@ -656,6 +803,9 @@ impl Case {
                 &p.position_m,
                 d,
             )?;
+        }
+        if let Some(f) = &self.open_flume {
+            self.validate_open_flume(f)?;
         }
         Ok(())
     }

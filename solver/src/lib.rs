@@ -7,6 +7,7 @@
 
 pub mod case;
 pub mod config;
+pub mod flume;
 pub mod gpu;
 pub mod observe;
 pub mod physics;
@@ -15,6 +16,7 @@ pub mod simulation;
 pub mod stages;
 
 pub use config::{Case, ConfigError};
+pub use flume::BoundaryConditions;
 pub use gpu::{GpuContext, GpuError};
 pub use observe::{Observations, ProfileColumn};
 pub use simulation::{Health, Recovery, Simulation, SolverError};

@@ -43,6 +43,29 @@ pub struct Observations {
     pub recoveries: u32,
     /// The CFL number in force.
     pub cfl: f64,
+    /// Particles per region of the scour model: index 1-5 as in Figure 2 of the paper (5 is
+    /// water), 0 walls and parked particles; for a multiphase case only.
+    pub region_counts: Option<[u32; 6]>,
+    /// Discharge, eroded mass and reservoir of an open flume.
+    pub flume: Option<FlumeObservation>,
+}
+
+/// What an open flume reports.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlumeObservation {
+    /// Discharge at the inlet, m3/s.
+    pub inflow_m3_per_s: f64,
+    /// Sediment particles collected (or gone over the weir) since the start.
+    pub eroded_particles: u64,
+    /// Eroded mass per metre of width (Eq. 34), kg/m, and times the flume width, kg.
+    pub eroded_kg_per_m: f64,
+    pub eroded_kg: f64,
+    /// Eroded mass per second since the previous observation, kg/s (whole width).
+    pub eroded_rate_kg_per_s: f64,
+    /// Particles parked (out of the flow, available to the inlet).
+    pub parked_particles: u64,
+    /// Inlet particles not placed for want of parked ones, since the start.
+    pub starved_particles: u64,
 }
 
 /// The top of each fluid phase's layer and the free surface along one vertical line.
@@ -242,6 +265,8 @@ impl ProbeLayout {
             fluid_particles: ext.fluid_count,
             recoveries: 0,
             cfl: 0.0,
+            region_counts: None,
+            flume: None,
         }
     }
 }

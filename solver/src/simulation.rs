@@ -5,10 +5,11 @@
 
 use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
+use crate::flume::{BoundaryConditions, FlumeState, MAX_INLET_MACH, parked_slots};
 use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use crate::gpu::params::*;
 use crate::gpu::{GpuContext, GpuError};
-use crate::observe::{self, Observations};
+use crate::observe::{self, FlumeObservation, Observations};
 use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
 use bytemuck::Zeroable;
 use std::sync::Arc;
@@ -126,6 +127,10 @@ pub struct Simulation {
     /// The CFL number to come back to after a recovery lowered it (the case's, or as set).
     cfl_target: f32,
     clean_chunks: u32,
+    /// The open flume's host state; None for a closed tank.
+    flume: Option<FlumeState>,
+    /// Time and eroded mass (kg/m) at the previous observation, for the erosion rate.
+    last_eroded: std::cell::Cell<(f64, f64)>,
 }
 
 fn divisions_of(case: &Case, h: f64) -> u32 {
@@ -133,7 +138,7 @@ fn divisions_of(case: &Case, h: f64) -> u32 {
 }
 
 /// Grid of cells of size 2h / cell_divisions covering the tank, its walls and a margin above it.
-fn grid_for(case: &Case, h: f64) -> Result<([u32; 4], [f32; 4]), SolverError> {
+fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverError> {
     let d = case.dim();
     let cell = 2.0 * h / f64::from(divisions_of(case, h));
     let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
@@ -144,7 +149,10 @@ fn grid_for(case: &Case, h: f64) -> Result<([u32; 4], [f32; 4]), SolverError> {
         let mut hi = case.domain.max_m[k] + margin;
         if k == d - 1 {
             // Room above the tank for splashes; particles above the grid still live in its top row.
-            hi += 0.25 * (case.domain.max_m[k] - case.domain.min_m[k]);
+            hi += case::SPLASH_ROOM * (case.domain.max_m[k] - case.domain.min_m[k]);
+            if case.open_flume.is_some() {
+                hi = hi.max(case::Parking::new(case, h).top(n) + margin);
+            }
         }
         dims[k] = ((hi - lo) / cell).ceil().clamp(1.0, f64::from(u32::MAX)) as u32;
         origin[k] = lo as f32;
@@ -162,9 +170,9 @@ fn grid_for(case: &Case, h: f64) -> Result<([u32; 4], [f32; 4]), SolverError> {
 impl Simulation {
     pub fn new(gpu: Arc<GpuContext>, case: &Case) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
-        let (grid_dims, _) = grid_for(case, derived.h)?;
-        let n_cells = u64::from(grid_dims[3]);
         let count = case::count(case);
+        let (grid_dims, _) = grid_for(case, derived.h, count)?;
+        let n_cells = u64::from(grid_dims[3]);
         // Particle indices are u32 on the GPU, with headroom for index arithmetic.
         if count >= u64::from(u32::MAX / 2) {
             return Err(SolverError::TooManyParticles(count));
@@ -202,7 +210,7 @@ impl Simulation {
         particles: Particles,
     ) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
-        let (grid_dims, grid_origin) = grid_for(case, derived.h)?;
+        let (grid_dims, grid_origin) = grid_for(case, derived.h, particles.len() as u64)?;
         GpuBuffers::check_limits(&gpu, particles.len() as u64, u64::from(grid_dims[3]))?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);
@@ -233,7 +241,8 @@ impl Simulation {
             bytemuck::cast_slice(&probes.points),
         );
         let verlet = matches!(case.numerics.integrator, Integrator::Verlet { .. });
-        let multiphase = matches!(case.numerics.viscosity, Viscosity::Multiphase);
+        let flume = FlumeState::new(case, &particles);
+        let multiphase = matches!(case.numerics.viscosity, Viscosity::Multiphase { .. });
         let pipeline = SphPipeline::new(
             &gpu,
             case.dimension,
@@ -259,6 +268,8 @@ impl Simulation {
             recoveries: Vec::new(),
             cfl_target: params.cfl,
             clean_chunks: 0,
+            flume,
+            last_eroded: std::cell::Cell::new((0.0, 0.0)),
         })
     }
 
@@ -274,6 +285,7 @@ impl Simulation {
     pub fn particle_count(&self) -> usize {
         self.initial_particles.len()
     }
+    /// Particles that are not walls (parked ones included: they are water out of the flow).
     pub fn fluid_count(&self) -> usize {
         (0..self.initial_particles.len())
             .filter(|&i| self.initial_particles.phase(i) != WALL_PHASE)
@@ -315,6 +327,7 @@ impl Simulation {
             });
         }
         let saved = (self.time_s, self.steps, self.last_dt_s, self.dt_taken);
+        let saved_flume = self.flume.clone();
         self.copy_state(&self.buffers.a, &self.buffers.snapshot);
         let mut tries = 0;
         loop {
@@ -332,6 +345,7 @@ impl Simulation {
                     self.clean_chunks = 0;
                     self.copy_state(&self.buffers.snapshot, &self.buffers.a);
                     (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
+                    self.flume.clone_from(&saved_flume);
                     self.params.cfl *= 0.5;
                     self.gpu.queue.write_buffer(
                         &self.buffers.params,
@@ -416,11 +430,17 @@ impl Simulation {
     /// submission is a GPU chunk whose time starts at zero, so f32 only ever holds the time
     /// of a few hundred steps; the host adds it to its f64 clock.
     fn run_chunk(&mut self, target_s: f64) -> Result<(), SolverError> {
-        let mut batch = self.steps_for(target_s - self.time_s);
+        let dp = self.case.numerics.dp_m;
         while target_s > self.time_s {
+            let remaining = target_s - self.time_s;
+            let max_span = self
+                .flume
+                .as_ref()
+                .map_or(f64::INFINITY, |f| f.max_span_s(dp));
+            let span = remaining.min(max_span);
             let euler_every = u64::from(self.params.euler_every);
             let init = StepState::chunk(
-                (target_s - self.time_s) as f32,
+                span as f32,
                 self.last_dt_s as f32,
                 self.dt_taken,
                 (self.steps % euler_every) as u32,
@@ -428,7 +448,7 @@ impl Simulation {
             self.gpu
                 .queue
                 .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
-            self.submit_steps(batch);
+            self.submit_steps(self.steps_for(span));
             let state = self.read_state()?;
             self.steps += u64::from(state.steps);
             self.last_dt_s = f64::from(state.last_dt);
@@ -442,14 +462,130 @@ impl Simulation {
                     health,
                 });
             }
-            if state.t_rel >= state.t_target {
-                self.time_s = target_s;
+            let reached = state.t_rel >= state.t_target;
+            let advanced = if reached {
+                span
             } else {
-                self.time_s += f64::from(state.t_rel);
+                f64::from(state.t_rel)
+            };
+            self.time_s = if reached && span == remaining {
+                target_s
+            } else {
+                self.time_s + advanced
+            };
+            if let Some(f) = &mut self.flume {
+                f.eroded_particles += u64::from(state.eroded);
+                f.parked_particles += u64::from(state.parked);
             }
-            batch = self.steps_for(target_s - self.time_s);
+            self.feed_inlet(advanced)?;
         }
         Ok(())
+    }
+
+    /// Fills the inlet columns due after `span_s` more of inflow with parked particles.
+    fn feed_inlet(&mut self, span_s: f64) -> Result<(), SolverError> {
+        let dp = self.case.numerics.dp_m;
+        let x_min = self.case.domain.min_m[0];
+        let Some(f) = &mut self.flume else {
+            return Ok(());
+        };
+        let injection = f.advance(span_s, dp, x_min);
+        if injection.columns_x_m.is_empty() {
+            return Ok(());
+        }
+        let heights = f.column_heights(dp);
+        let u = f.inlet_velocity() as f32;
+        let n = self.initial_particles.len() as u64;
+        let a = &self.buffers.a;
+        let raw = read_buffers(&self.gpu, &[(&a.positions, n * 16), (&a.ids, n * 4)])?;
+        let positions: Vec<[f32; 4]> = cast_vec(&raw[0]);
+        let ids: Vec<u32> = cast_vec(&raw[1]);
+        let fl = self.params.flume;
+        // The buffer keeps the density its particles enter with (store_state.wgsl): rest.
+        let rho = self.params.phases[fl.water_phase as usize].rho0;
+        let mut free = parked_slots(&positions, &ids, fl.parked_phase).into_iter();
+        let mut starved = 0u64;
+        let mut placed = 0u64;
+        // A spot some particle has wandered into stays empty this time: a particle placed on
+        // top of another would send both densities out of range.
+        let occupied = |x: f64, y: f64| {
+            let r2 = (0.5 * dp) * (0.5 * dp);
+            positions.iter().any(|p| {
+                let (dx, dy) = (f64::from(p[0]) - x, f64::from(p[1]) - y);
+                p[3].to_bits() != fl.parked_phase && dx * dx + dy * dy < r2
+            })
+        };
+        for &x in &injection.columns_x_m {
+            for &y in &heights {
+                if occupied(x, y) {
+                    f.blocked_particles += 1;
+                    continue;
+                }
+                let Some(slot) = free.next() else {
+                    starved += 1;
+                    continue;
+                };
+                let offset = slot as u64 * 16;
+                let pos = [x as f32, y as f32, 0.0, f32::from_bits(fl.water_phase)];
+                let vr = [u, 0.0, 0.0, rho];
+                let q = &self.gpu.queue;
+                q.write_buffer(&a.positions, offset, bytemuck::bytes_of(&pos));
+                q.write_buffer(&a.vel_rho, offset, bytemuck::bytes_of(&vr));
+                q.write_buffer(&a.vel_rho_prev, offset, bytemuck::bytes_of(&vr));
+                placed += 1;
+            }
+        }
+        f.parked_particles = f.parked_particles.saturating_sub(placed);
+        f.injected_particles += placed;
+        if starved > 0 {
+            f.starved_particles += starved;
+            log::warn!(
+                "t = {:.3} s: the inlet is short of {starved} particles: none is parked (the flume holds all it can; raise open_flume.reservoir_particles)",
+                self.time_s
+            );
+        }
+        Ok(())
+    }
+
+    /// Sets the discharge of an open flume's inlet from the next step on. Refuses a negative or
+    /// non-finite discharge, one whose inlet velocity passes `MAX_INLET_MACH` c0, and a case
+    /// without an open flume.
+    pub fn set_boundary_conditions(&mut self, bc: BoundaryConditions) -> Result<(), SolverError> {
+        let c0 = f64::from(self.params.c0);
+        let Some(f) = &mut self.flume else {
+            return Err(SolverError::InvalidParameter {
+                name: "inflow",
+                reason: "the case has no open flume".into(),
+            });
+        };
+        let q = bc.inflow_m3_per_s;
+        if !(q.is_finite() && q >= 0.0) {
+            return Err(SolverError::InvalidParameter {
+                name: "inflow",
+                reason: format!("must be a finite discharge >= 0 m3/s, got {q}"),
+            });
+        }
+        let u = crate::simulation::inlet_velocity(&f.config, q);
+        if u > MAX_INLET_MACH * c0 {
+            return Err(SolverError::InvalidParameter {
+                name: "inflow",
+                reason: format!(
+                    "{q} m3/s gives an inlet velocity of {u:.3} m/s, above {MAX_INLET_MACH} c0 = {:.3} m/s",
+                    MAX_INLET_MACH * c0
+                ),
+            });
+        }
+        f.inflow_m3_per_s = q;
+        self.params.flume.inlet_u = u as f32;
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        Ok(())
+    }
+
+    /// The open flume's host state (discharge, eroded and parked counts); None for a tank.
+    pub fn flume(&self) -> Option<&FlumeState> {
+        self.flume.as_ref()
     }
 
     /// Steps estimated to cover `span_s` at the last CFL step (or the acoustic bound before
@@ -625,6 +761,36 @@ impl Simulation {
                 .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext);
         obs.recoveries = self.recoveries.len() as u32;
         obs.cfl = self.cfl();
+        if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
+            let mut counts = [0u32; 6];
+            for w in self.regions()? {
+                counts[((w & 255) as usize).min(5)] += 1;
+            }
+            obs.region_counts = Some(counts);
+        }
+        if let Some(f) = &self.flume {
+            let sediment_mass = self
+                .case
+                .sediment_phases()
+                .map_or(0.0, |(k, _)| self.derived.phases[k + 1].mass);
+            let kg_per_m = f.eroded_kg_per_m(sediment_mass);
+            let kg = kg_per_m * f.config.width_m;
+            let (t_prev, kg_prev) = self.last_eroded.replace((self.time_s, kg));
+            let rate = if self.time_s > t_prev {
+                (kg - kg_prev) / (self.time_s - t_prev)
+            } else {
+                0.0
+            };
+            obs.flume = Some(FlumeObservation {
+                inflow_m3_per_s: f.inflow_m3_per_s,
+                eroded_particles: f.eroded_particles,
+                eroded_kg_per_m: kg_per_m,
+                eroded_kg: kg,
+                eroded_rate_kg_per_s: rate,
+                parked_particles: f.parked_particles,
+                starved_particles: f.starved_particles,
+            });
+        }
         Ok(obs)
     }
 }
@@ -670,7 +836,7 @@ fn sim_params(
     let (viscosity_mode, alpha) = match case.numerics.viscosity {
         Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha),
         Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0),
-        Viscosity::Multiphase => (VISCOSITY_MULTIPHASE, 0.0),
+        Viscosity::Multiphase { alpha } => (VISCOSITY_MULTIPHASE, alpha),
     };
     let (diffusion_mode, delta) = match case.numerics.density_diffusion {
         DensityDiffusion::None => (DIFFUSION_NONE, 0.0),
@@ -703,11 +869,49 @@ fn sim_params(
             Integrator::Verlet { euler_every_steps } => euler_every_steps,
             Integrator::Symplectic => 1,
         },
-        pad: [0; 3],
+        clamp_pressure: u32::from(case.numerics.clamp_negative_pressure),
+        pad: [0; 2],
         phases,
         tait_b,
         sediment: sediment_params(case, derived),
+        flume: flume_params(case, derived),
     }
+}
+
+/// The open-flume block of the uniform; all zero (disabled) for a closed tank. The inlet
+/// velocity starts from the case's discharge.
+fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
+    let Some(f) = &case.open_flume else {
+        return FlumeGpu::zeroed();
+    };
+    let dp = case.numerics.dp_m;
+    let parking = case::Parking::new(case, derived.h);
+    let (lo, hi) = (&case.domain.min_m, &case.domain.max_m);
+    FlumeGpu {
+        enabled: 1,
+        water_phase: 1 + case.sediment_phases().map_or(0, |(_, w)| w) as u32,
+        parked_phase: case::parked_phase(case),
+        parking_cols: parking.cols,
+        inlet_x_face: (lo[0] + (f64::from(f.inlet.layers) + 0.5) * dp) as f32,
+        // Half a dp of margin each way: the buffer's rows are lattice points inside the
+        // opening, and a row must not drop out of the zone by rounding.
+        inlet_y_min: f.inlet.y_min_m as f32,
+        inlet_y_max: (f.inlet.y_min_m + f.inlet.height_m + 0.5 * dp) as f32,
+        inlet_u: inlet_velocity(f, f.inflow_m3_per_s) as f32,
+        outlet_x: (hi[0] + f64::from(case.walls.layers) * dp) as f32,
+        collector_x_min: f.collector.x_min_m as f32,
+        collector_x_max: f.collector.x_max_m as f32,
+        collector_y_max: f.collector.y_max_m as f32,
+        parking_x0: parking.x0 as f32,
+        parking_y0: parking.y0 as f32,
+        parking_dp: dp as f32,
+        pad: 0.0,
+    }
+}
+
+/// Inlet velocity of discharge `q` (m3/s) through the opening: Q / (height x width), m/s.
+pub fn inlet_velocity(f: &crate::config::OpenFlume, q: f64) -> f64 {
+    q / (f.inlet.height_m * f.width_m)
 }
 
 /// The sediment block of the uniform; all zero (phase 0, the walls) when the case has none.

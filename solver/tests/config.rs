@@ -171,3 +171,89 @@ fn wrong_types_and_missing_fields_are_named() {
     assert!(f.starts_with("numerics.viscosity"), "{f}");
     assert!(r.contains("unknown variant `sps`"), "{r}");
 }
+
+const ULBRA: &str = include_str!("../../launch_configs/ulbra_flume.yaml");
+
+#[test]
+fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
+    for (from, to, field, reason) in [
+        (
+            "friction_angle_deg: 32.0",
+            "friction_angle_deg: 95.0",
+            "phases[1].sediment.friction_angle_deg",
+            "between 0 and 90",
+        ),
+        (
+            "d50_m: 0.0004",
+            "d50_m: -0.0004",
+            "phases[1].sediment.d50_m",
+            "positive",
+        ),
+        (
+            "viscosity: { method: multiphase, alpha: 0.02 }",
+            "viscosity: { method: artificial, alpha: 0.02 }",
+            "numerics.viscosity.method",
+            "multiphase",
+        ),
+        (
+            "rho0_kg_per_m3: 2710.0",
+            "rho0_kg_per_m3: 900.0",
+            "phases[1].rho0_kg_per_m3",
+            "denser than the water",
+        ),
+        (
+            "height_m: 0.02",
+            "height_m: 0.001",
+            "open_flume.inlet.height_m",
+            "at least dp",
+        ),
+        (
+            "outlet_weir_m: 0.055",
+            "outlet_weir_m: 0.5",
+            "open_flume.outlet_weir_m",
+            "within the domain",
+        ),
+        (
+            "x_min_m: 2.22",
+            "x_min_m: 2.2",
+            "open_flume.collector.x_min_m",
+            "reaches into the collector",
+        ),
+        (
+            "inflow_m3_per_s: 5.5556e-4",
+            "inflow_m3_per_s: -1.0",
+            "open_flume.inflow_m3_per_s",
+            ">= 0",
+        ),
+    ] {
+        assert!(ULBRA.contains(from), "{from}");
+        let (f, r) = refused(&ULBRA.replace(from, to));
+        assert_eq!(f, field, "{to}: {r}");
+        assert!(r.contains(reason), "{to}: {r}");
+    }
+}
+
+#[test]
+fn an_open_flume_parks_its_reservoir_above_the_flow() {
+    let c = launch_config("ulbra_flume.yaml");
+    let d = case::derive(&c);
+    let p = case::generate(&c, &d);
+    let parked = case::parked_phase(&c);
+    let parking = case::Parking::new(&c, d.h);
+    let f = c.open_flume.as_ref().expect("open flume");
+    let mut n = 0;
+    for i in 0..p.len() {
+        if p.phase(i) != parked {
+            continue;
+        }
+        n += 1;
+        // Each at its own spot, by id, and more than 2h above anything that is not parked.
+        assert_eq!(p.positions[i][..2], parking.spot(p.ids[i]));
+        assert!(f64::from(p.positions[i][1]) >= c.domain.max_m[1] + 2.0 * d.h);
+    }
+    assert_eq!(n, f.reservoir_particles as usize);
+    assert!(
+        case::count(&c) as usize >= p.len(),
+        "count is an upper bound"
+    );
+}

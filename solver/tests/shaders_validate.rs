@@ -2,7 +2,7 @@
 //! workgroup size match the WGSL, and the Rust mirrors of WGSL structs have naga's layout.
 
 use flume_solver::gpu::params::{
-    Extremes, PhaseParams, ScanInfo, SedimentGpu, SimParams, StepState,
+    Extremes, FlumeGpu, PhaseParams, ScanInfo, SedimentGpu, SimParams, StepState,
 };
 use flume_solver::gpu::stage::Access;
 use flume_solver::stages::ALL;
@@ -191,9 +191,32 @@ fn rust_mirrors_have_the_wgsl_layout() {
         vertical_axis,
         n_probes,
         euler_every,
+        clamp_pressure,
         phases,
         tait_b,
-        sediment
+        sediment,
+        flume
+    );
+    let (m, size) = wgsl_layout(&module, "Flume");
+    assert_eq!(size as usize, size_of::<FlumeGpu>());
+    same!(
+        FlumeGpu,
+        m,
+        enabled,
+        water_phase,
+        parked_phase,
+        parking_cols,
+        inlet_x_face,
+        inlet_y_min,
+        inlet_y_max,
+        inlet_u,
+        outlet_x,
+        collector_x_min,
+        collector_x_max,
+        collector_y_max,
+        parking_x0,
+        parking_y0,
+        parking_dp
     );
     let (m, size) = wgsl_layout(&module, "Sediment");
     assert_eq!(size as usize, size_of::<SedimentGpu>());
@@ -236,7 +259,9 @@ fn rust_mirrors_have_the_wgsl_layout() {
         last_dt,
         step_base,
         dt_prev,
-        dt_taken
+        dt_taken,
+        eroded,
+        parked
     );
 
     let observe = ALL

@@ -141,6 +141,40 @@ impl<W: Write> BedProfileCsv<W> {
     }
 }
 
+/// An open flume's discharge and eroded mass, one row per output interval (Eq. 34).
+pub struct ErodedMassCsv<W: Write> {
+    w: W,
+}
+
+impl<W: Write> ErodedMassCsv<W> {
+    pub fn new(mut w: W) -> io::Result<Self> {
+        writeln!(
+            w,
+            "time_s,inflow_m3_per_s,eroded_particles,eroded_kg_per_m,eroded_kg,eroded_rate_kg_per_s,parked_particles"
+        )?;
+        w.flush()?;
+        Ok(ErodedMassCsv { w })
+    }
+
+    pub fn row(&mut self, obs: &Observations) -> io::Result<()> {
+        let Some(f) = obs.flume else {
+            return Ok(());
+        };
+        writeln!(
+            self.w,
+            "{},{},{},{},{},{},{}",
+            obs.time_s,
+            f.inflow_m3_per_s,
+            f.eroded_particles,
+            f.eroded_kg_per_m,
+            f.eroded_kg,
+            f.eroded_rate_kg_per_s,
+            f.parked_particles
+        )?;
+        self.w.flush()
+    }
+}
+
 /// Quotes a header cell when a gauge name would otherwise break the CSV (RFC 4180).
 fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
@@ -189,6 +223,8 @@ mod tests {
             fluid_particles: 3200,
             recoveries: 1,
             cfl: 0.1,
+            region_counts: None,
+            flume: None,
         };
         csv.row(&obs).unwrap();
         let text = String::from_utf8(buf).unwrap();
@@ -226,6 +262,8 @@ mod tests {
             fluid_particles: 0,
             recoveries: 0,
             cfl: 0.2,
+            region_counts: None,
+            flume: None,
         };
         csv.rows(&obs).unwrap();
         assert_eq!(
@@ -265,6 +303,8 @@ mod tests {
             fluid_particles: 0,
             recoveries: 0,
             cfl: 0.2,
+            region_counts: None,
+            flume: None,
         };
         csv.rows(&obs).unwrap();
         assert_eq!(

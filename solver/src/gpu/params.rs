@@ -41,6 +41,28 @@ pub struct SedimentGpu {
     pub pad1: f32,
 }
 
+/// Mirrors `Flume` in `shaders/common/params.wgsl` (units there).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct FlumeGpu {
+    pub enabled: u32,
+    pub water_phase: u32,
+    pub parked_phase: u32,
+    pub parking_cols: u32,
+    pub inlet_x_face: f32,
+    pub inlet_y_min: f32,
+    pub inlet_y_max: f32,
+    pub inlet_u: f32,
+    pub outlet_x: f32,
+    pub collector_x_min: f32,
+    pub collector_x_max: f32,
+    pub collector_y_max: f32,
+    pub parking_x0: f32,
+    pub parking_y0: f32,
+    pub parking_dp: f32,
+    pub pad: f32,
+}
+
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct SimParams {
@@ -64,10 +86,12 @@ pub struct SimParams {
     pub vertical_axis: u32,
     pub n_probes: u32,
     pub euler_every: u32,
-    pub pad: [u32; 3],
+    pub clamp_pressure: u32,
+    pub pad: [u32; 2],
     pub phases: [PhaseParams; MAX_PHASES],
     pub tait_b: [f32; 4],
     pub sediment: SedimentGpu,
+    pub flume: FlumeGpu,
 }
 
 pub const VISCOSITY_ARTIFICIAL: u32 = 0;
@@ -91,7 +115,8 @@ pub struct StepState {
     pub step_base: u32,
     pub dt_prev: f32,
     pub dt_taken: f32,
-    pub pad: [u32; 2],
+    pub eroded: u32,
+    pub parked: u32,
 }
 
 impl StepState {
@@ -110,7 +135,8 @@ impl StepState {
             step_base,
             dt_prev: 0.0,
             dt_taken,
-            pad: [0; 2],
+            eroded: 0,
+            parked: 0,
         }
     }
 }

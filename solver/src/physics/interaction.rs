@@ -78,7 +78,12 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
         .zip(vel_rho)
         .map(|(p, v)| {
             let k = phase_index(p);
-            pressure(v[3], params.phases[k].rho0, stiffness[k])
+            let p = pressure(v[3], params.phases[k].rho0, stiffness[k]);
+            if params.clamp_negative_pressure {
+                p.max(0.0)
+            } else {
+                p
+            }
         })
         .collect();
 
@@ -147,7 +152,7 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
             }
 
             match params.viscosity {
-                Viscosity::Artificial { alpha } => {
+                Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } => {
                     // Only approaching pairs are damped.
                     if vdotr < 0.0 {
                         let mu_ij = h * vdotr / (r2 + eta2);
@@ -166,8 +171,6 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
                         acc[k] += s * v_ij[k];
                     }
                 }
-                // The viscous stress enters through `sediment::pass::stress_divergence`.
-                Viscosity::Multiphase => {}
             }
 
             visc_max = visc_max.max((h * vdotr / (r2 + eta2)).abs());
@@ -229,6 +232,7 @@ mod tests {
             gravity: [0.0, -9.81, 0.0],
             delta: 0.0,
             hydrostatic_diffusion: true,
+            clamp_negative_pressure: false,
             viscosity: Viscosity::Artificial { alpha: 0.0 },
             cfl: 0.2,
             phases: vec![water(mass), wall(mass)],

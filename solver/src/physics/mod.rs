@@ -40,9 +40,10 @@ pub enum Viscosity {
     Artificial { alpha: f32 },
     /// Morris et al. (1997) laminar viscosity with each phase's dynamic viscosity `mu`.
     Laminar,
-    /// Viscous stress from each particle's strain rate (Eqs. 10-15): no pairwise viscous term
-    /// here, the stress divergence of [`sediment::pass`] instead.
-    Multiphase,
+    /// Viscous stress from each particle's strain rate (Eqs. 10-15), added as the stress
+    /// divergence of [`sediment::pass`]; here only Monaghan's artificial viscosity with
+    /// coefficient `alpha` (0 for none).
+    Multiphase { alpha: f32 },
 }
 
 /// Numerical parameters of one run.
@@ -63,6 +64,8 @@ pub struct Params {
     pub delta: f32,
     /// Viscosity model.
     pub viscosity: Viscosity,
+    /// Negative pressures count as zero in the momentum equation (not in probes).
+    pub clamp_negative_pressure: bool,
     /// Courant number C_CFL (dimensionless, typically 0.2).
     pub cfl: f32,
     /// Phase table, indexed by the phase bits of the positions.

@@ -99,6 +99,7 @@ mod tests {
             gravity: [0.0, -9.81, 0.0],
             delta: 0.1,
             hydrostatic_diffusion: true,
+            clamp_negative_pressure: false,
             viscosity: Viscosity::Artificial { alpha: 0.01 },
             cfl: 0.2,
             phases: vec![

@@ -38,6 +38,7 @@ mod tests {
             gravity: [0.0, -9.81, 0.0],
             delta: 0.1,
             hydrostatic_diffusion: true,
+            clamp_negative_pressure: false,
             viscosity: Viscosity::Laminar,
             cfl: 0.2,
             phases,

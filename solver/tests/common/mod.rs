@@ -54,10 +54,11 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
         gravity: [p.gravity[0], p.gravity[1], p.gravity[2]],
         delta: p.delta_h_c0 / (p.h * p.c0),
         hydrostatic_diffusion: p.diffusion_mode == flume_solver::gpu::params::DIFFUSION_FOURTAKAS,
+        clamp_negative_pressure: p.clamp_pressure != 0,
         viscosity: match p.viscosity_mode {
             VISCOSITY_ARTIFICIAL => Viscosity::Artificial { alpha: p.alpha },
             VISCOSITY_LAMINAR => Viscosity::Laminar,
-            _ => Viscosity::Multiphase,
+            _ => Viscosity::Multiphase { alpha: p.alpha },
         },
         cfl: p.cfl,
         phases: p.phases[..n_phases]
