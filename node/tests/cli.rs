@@ -320,3 +320,38 @@ fn check_vtk_header(bytes: &[u8], n: usize) {
     assert_eq!(take_line(&mut rest), format!("CELLS {n} {}", 2 * n));
     assert_eq!(i32::from_be_bytes(rest[..4].try_into().unwrap()), 1);
 }
+
+/// `--inflow` is checked before the GPU is opened: a case without an open flume, and a series
+/// with a negative discharge, each fail with the reason (and the line).
+#[test]
+fn a_bad_inflow_series_is_refused_with_its_line() {
+    let dir = scratch("inflow");
+    let series = dir.join("q.csv");
+    fs::write(&series, "t_s,q_m3_per_s\n0,0.0005\n5,-0.001\n").unwrap();
+    let series = series.to_str().unwrap();
+    let out = flume_twin(&[
+        "simulate",
+        repo_file("launch_configs/dambreak_water.yaml")
+            .to_str()
+            .unwrap(),
+        "--inflow",
+        series,
+    ]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("has no open_flume"), "{err}");
+    let out = flume_twin(&[
+        "simulate",
+        repo_file("launch_configs/ulbra_flume.yaml")
+            .to_str()
+            .unwrap(),
+        "--inflow",
+        series,
+    ]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("line 3: discharge -0.001 m3/s must be finite and >= 0"),
+        "{err}"
+    );
+}
