@@ -293,9 +293,9 @@ pub enum Viscosity {
     Laminar,
     /// The viscous stress tau = 2 mu eps of Eqs. 10-11 and 14 from each particle's strain rate,
     /// mu the water's viscosity or, for sediment, the apparent viscosity of its region; plus,
-    /// with `alpha` > 0, Monaghan's artificial viscosity on every pair. Water's own viscosity
-    /// does nothing at these resolutions, and a thin sheet of water then clumps into pairs
-    /// that collide (the flume's front over the dry bed did at dp = 1 cm).
+    /// with `alpha` > 0, Monaghan's artificial viscosity on every pair: water's own viscosity
+    /// does next to nothing at these resolutions, and a violent flow (the flume's jet) needs
+    /// some damping of particle noise, as the water-only cases get from `artificial`.
     Multiphase {
         #[serde(default)]
         alpha: f64,
