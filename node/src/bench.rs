@@ -99,7 +99,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     println!();
     println!(
-        "open flume {} ({}), dp = {} m, from the dry start with the inlet running;          particle-steps count the particles in the flow (not the parked ones)",
+        "open flume {} ({}), dp = {} m, from the dry start with the inlet running;\n\
+         particle-steps count the particles in the flow (not the parked ones)",
         flume.name,
         args.flume.display(),
         flume.numerics.dp_m
