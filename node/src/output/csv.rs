@@ -235,6 +235,26 @@ mod tests {
         );
     }
 
+    /// Observations at `time_s` holding only a profile.
+    fn profile_at(time_s: f64, profile: Vec<flume_solver::ProfileColumn>) -> Observations {
+        Observations {
+            time_s,
+            steps: 1,
+            dt_s: 1e-4,
+            gauges: vec![],
+            probes: vec![],
+            profile,
+            front_m: None,
+            max_speed_m_per_s: 0.0,
+            max_density_error: 0.0,
+            fluid_particles: 0,
+            recoveries: 0,
+            cfl: 0.2,
+            region_counts: None,
+            flume: None,
+        }
+    }
+
     #[test]
     fn bed_profile_rows_skip_columns_without_interfaces() {
         let mut buf = Vec::new();
@@ -244,27 +264,15 @@ mod tests {
             zs_m: Some(0.0625),
             zw_m: None,
         };
-        let obs = Observations {
-            time_s: 0.25,
-            steps: 1,
-            dt_s: 1e-4,
-            gauges: vec![],
-            probes: vec![],
-            profile: vec![flume_solver::ProfileColumn {
+        let obs = profile_at(
+            0.25,
+            vec![flume_solver::ProfileColumn {
                 x_m: 1.0,
                 surface_m: None,
                 layer_tops_m: vec![None, Some(0.0625)],
                 bed: Some(bed),
             }],
-            front_m: None,
-            max_speed_m_per_s: 0.0,
-            max_density_error: 0.0,
-            fluid_particles: 0,
-            recoveries: 0,
-            cfl: 0.2,
-            region_counts: None,
-            flume: None,
-        };
+        );
         csv.rows(&obs).unwrap();
         assert_eq!(
             String::from_utf8(buf).unwrap(),
@@ -277,13 +285,9 @@ mod tests {
         let mut buf = Vec::new();
         let mut csv =
             ProfileCsv::new(&mut buf, &["water".to_string(), "sand".to_string()]).unwrap();
-        let obs = Observations {
-            time_s: 0.5,
-            steps: 1,
-            dt_s: 1e-4,
-            gauges: vec![],
-            probes: vec![],
-            profile: vec![
+        let obs = profile_at(
+            0.5,
+            vec![
                 flume_solver::ProfileColumn {
                     x_m: 0.25,
                     surface_m: Some(0.1),
@@ -297,15 +301,7 @@ mod tests {
                     bed: None,
                 },
             ],
-            front_m: None,
-            max_speed_m_per_s: 0.0,
-            max_density_error: 0.0,
-            fluid_particles: 0,
-            recoveries: 0,
-            cfl: 0.2,
-            region_counts: None,
-            flume: None,
-        };
+        );
         csv.rows(&obs).unwrap();
         assert_eq!(
             String::from_utf8(buf).unwrap(),
