@@ -329,29 +329,17 @@ fn a_bad_inflow_series_is_refused_with_its_line() {
     let series = dir.join("q.csv");
     fs::write(&series, "t_s,q_m3_per_s\n0,0.0005\n5,-0.001\n").unwrap();
     let series = series.to_str().unwrap();
-    let out = flume_twin(&[
-        "simulate",
-        repo_file("launch_configs/dambreak_water.yaml")
-            .to_str()
-            .unwrap(),
-        "--inflow",
-        series,
-    ]);
-    assert!(!out.status.success());
-    let err = text(&out.stderr);
-    assert!(err.contains("has no open_flume"), "{err}");
-    let out = flume_twin(&[
-        "simulate",
-        repo_file("launch_configs/ulbra_flume.yaml")
-            .to_str()
-            .unwrap(),
-        "--inflow",
-        series,
-    ]);
-    assert!(!out.status.success());
-    let err = text(&out.stderr);
-    assert!(
-        err.contains("line 3: discharge -0.001 m3/s must be finite and >= 0"),
-        "{err}"
-    );
+    for (case, reason) in [
+        ("launch_configs/dambreak_water.yaml", "has no open_flume"),
+        (
+            "launch_configs/ulbra_flume.yaml",
+            "line 3: discharge -0.001 m3/s must be finite and >= 0",
+        ),
+    ] {
+        let case = repo_file(case);
+        let out = flume_twin(&["simulate", case.to_str().unwrap(), "--inflow", series]);
+        assert!(!out.status.success());
+        let err = text(&out.stderr);
+        assert!(err.contains(reason), "{err}");
+    }
 }

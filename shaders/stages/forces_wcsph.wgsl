@@ -36,10 +36,7 @@ override REDUCE_DT: bool = true;
 @compute @workgroup_size(64)
 fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    // Steps recorded past the end of a chunk (or after a blow-up) skip the costly pass: before
-    // dt_update the chunk has ended when its time is reached, after it when the step is zero.
-    let idle = select(state.dt == 0.0, state.t_rel >= state.t_target, REDUCE_DT);
-    if (i >= params.n_particles || idle || atomicLoad(&state.status) != 0u) {
+    if (i >= params.n_particles || chunk_idle(REDUCE_DT)) {
         return;
     }
     let pos_i = textureLoad(positions, texel(i), 0);

@@ -21,8 +21,7 @@ override BEFORE_DT: bool = true;
 @compute @workgroup_size(64)
 fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    let idle = select(state.dt == 0.0, state.t_rel >= state.t_target, BEFORE_DT);
-    if (i >= params.n_particles || idle || atomicLoad(&state.status) != 0u) {
+    if (i >= params.n_particles || chunk_idle(BEFORE_DT)) {
         return;
     }
     let pos_i = textureLoad(positions, texel(i), 0);
@@ -148,8 +147,8 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
         switch (region) {
-            case 3u: { mu = hbp_viscosity(ii_d, tau_bcr); }
-            case 4u: { mu = vand_viscosity(c_v); }
+            case REGION_BED_LOAD: { mu = hbp_viscosity(ii_d, tau_bcr); }
+            case REGION_SUSPENDED: { mu = vand_viscosity(c_v); }
             default: { mu = hbp_viscosity(ii_d, tau_y); }
         }
         mu = min(mu, sd.mu_max);

@@ -19,6 +19,18 @@ const WITH_NEIGHBOURS: &[&str] = &[
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
 ];
+/// The neighbour passes that run inside a step: they skip the steps past a chunk's end.
+const NEIGHBOUR_PASS: &[&str] = &[
+    "common/params.wgsl",
+    "common/kernel.wgsl",
+    "common/eos.wgsl",
+    "common/grid.wgsl",
+    "common/neighbours.wgsl",
+    "common/particle_texture.wgsl",
+    "common/step_state.wgsl",
+    "common/chunk_idle.wgsl",
+    "common/sediment.wgsl",
+];
 const WITH_STATE: &[&str] = &["common/params.wgsl", "common/step_state.wgsl"];
 const HALF_STEP: &[&str] = &[
     "common/params.wgsl",
@@ -126,7 +138,7 @@ pub const REORDER: StageSpec = StageSpec {
 pub const FORCES_WCSPH: StageSpec = StageSpec {
     name: "forces_wcsph",
     shader: "stages/forces_wcsph.wgsl",
-    imports: WITH_NEIGHBOURS,
+    imports: NEIGHBOUR_PASS,
     bindings: &[
         ("params", 0, Uniform),
         ("positions", 1, Texture),
@@ -144,16 +156,7 @@ pub const FORCES_WCSPH: StageSpec = StageSpec {
 pub const RHEOLOGY: StageSpec = StageSpec {
     name: "rheology",
     shader: "stages/rheology.wgsl",
-    imports: &[
-        "common/params.wgsl",
-        "common/kernel.wgsl",
-        "common/eos.wgsl",
-        "common/grid.wgsl",
-        "common/neighbours.wgsl",
-        "common/particle_texture.wgsl",
-        "common/step_state.wgsl",
-        "common/sediment.wgsl",
-    ],
+    imports: NEIGHBOUR_PASS,
     bindings: &[
         ("params", 0, Uniform),
         ("positions", 1, Texture),

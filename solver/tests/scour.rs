@@ -289,3 +289,57 @@ fn a_sediment_blow_up_is_caught_and_recovered() {
     let regions = obs.region_counts.expect("multiphase");
     assert_eq!(regions.iter().sum::<u32>() as usize, p.len());
 }
+
+/// The outlet and the collector: water spilling over the weir is parked, sand sinking into the
+/// collector is parked as water and counted as eroded (Eq. 34), and nothing is lost: the particle
+/// count is fixed and the mass balances once the collected sand is counted.
+#[test]
+fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c =
+        Case::from_path(&common::case_path("tests/cases/collector_2d.yaml")).expect("case parses");
+    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    let parked = flume_solver::case::parked_phase(&c);
+    let start = sim.read_particles().expect("reads");
+    sim.advance_to(0.5).expect("runs");
+    let obs = sim.observe().expect("observes");
+    let now = sim.read_particles().expect("reads");
+    let f = obs.flume.expect("an open flume reports");
+    let (sand0, sand1) = (count_phase(&start, SAND), count_phase(&now, SAND));
+    let (parked0, parked1) = (count_phase(&start, parked), count_phase(&now, parked));
+    eprintln!(
+        "sand {sand0} -> {sand1}, parked {parked0} -> {parked1}, {f:?}, recoveries {}",
+        obs.recoveries
+    );
+    assert!(f.eroded_particles > 0, "no sand reached the collector");
+    assert_eq!(
+        f.eroded_particles,
+        (sand0 - sand1) as u64,
+        "eroded = sand gone"
+    );
+    let spilled = parked1 - parked0 - f.eroded_particles as usize;
+    assert!(spilled > 0, "no water went over the weir");
+    assert_eq!(f.parked_particles, parked1 as u64);
+    // Eq. 34: N dp^2 rho_s per metre, times the width.
+    let m_s = sim.derived().phases[SAND as usize].mass;
+    assert!((f.eroded_kg_per_m - f.eroded_particles as f64 * m_s).abs() < 1e-12);
+    assert!((f.eroded_kg - f.eroded_kg_per_m * 0.086).abs() < 1e-12);
+    // Nothing leaks: same particles; the mass now plus what the collected sand outweighed the
+    // water it became is the mass at the start.
+    assert_eq!(now.len(), start.len());
+    let mass = |p: &Particles| -> f64 {
+        (0..p.len())
+            .map(|i| sim.derived().phases[p.phase(i) as usize].mass)
+            .sum()
+    };
+    let m_w = sim.derived().phases[WATER as usize].mass;
+    let balance = mass(&now) + f.eroded_particles as f64 * (m_s - m_w);
+    assert!((balance - mass(&start)).abs() < 1e-9 * mass(&start));
+    for i in 0..now.len() {
+        assert!(now.positions[i][0].is_finite() && now.positions[i][1].is_finite());
+        if start.phase(i) == SAND && now.phase(i) != SAND {
+            assert_eq!(now.phase(i), parked, "collected sand {i} is parked water");
+        }
+    }
+}

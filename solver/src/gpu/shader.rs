@@ -21,6 +21,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "common/step_state.wgsl",
     "common/store_state.wgsl",
     "common/sediment.wgsl",
+    "common/chunk_idle.wgsl",
     "stages/grid_clear.wgsl",
     "stages/grid_count.wgsl",
     "stages/prefix_sum.wgsl",
