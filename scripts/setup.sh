@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what flume-twin needs on a fresh Debian/Ubuntu machine: a Vulkan driver (Mesa's
-# lavapipe, the software Vulkan device, when no GPU driver is present) and checks for cargo.
+# lavapipe, the software Vulkan device, when no GPU driver is present), the DejaVu font for the
+# labels of the bed plot, and checks for cargo.
 # Sourced by scripts/run.sh and scripts/test.sh; safe to run again.
 set -euo pipefail
 
@@ -22,6 +23,17 @@ if ! have_vulkan_icd; then
   if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq mesa-vulkan-drivers >/dev/null
+fi
+
+# The bed plot draws without labels when the font is missing; install it where apt can.
+if [ ! -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] && command -v apt-get >/dev/null 2>&1; then
+  echo "DejaVu Sans not found: installing fonts-dejavu-core (labels of the bed plot)" >&2
+  sudo_cmd=""
+  if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
+  if ! { $sudo_cmd apt-get update -qq &&
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq fonts-dejavu-core >/dev/null; }; then
+    echo "could not install fonts-dejavu-core: bed plots will have no labels" >&2
+  fi
 fi
 
 # Mesa's device-select layer complains on stderr when this is unset; it is harmless but noisy.

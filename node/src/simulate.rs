@@ -3,6 +3,7 @@
 use crate::cli::SimulateArgs;
 use crate::inflow::InflowSeries;
 use crate::output::{
+    bed_plot,
     csv::{BedProfileCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
     vtk,
 };
@@ -70,6 +71,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     progress.set_message(format!("t = 0/{end_s} s"));
     let started = Instant::now();
     let mut last = recorder.record(&sim, 0)?;
+    let initial_profile = last.profile.clone();
     for k in 1..=intervals {
         let target_s = (k as f64 * interval_s).min(end_s);
         if let Err(err) = advance(&mut sim, inflow.as_ref(), target_s) {
@@ -100,6 +102,17 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     progress.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
+    if recorder.bed_profile.is_some() {
+        let path = out_dir.join("bed.png");
+        bed_plot::draw(
+            &path,
+            &case.name,
+            &initial_profile,
+            &last.profile,
+            sim.time_s(),
+        )?;
+        println!("bed plot: {}", path.display());
+    }
     print_summary(&sim, &last, wall_s);
     Ok(())
 }

@@ -343,3 +343,47 @@ fn a_bad_inflow_series_is_refused_with_its_line() {
         assert!(err.contains(reason), "{err}");
     }
 }
+
+/// A flume run writes the scour outputs: bed_profile.csv, eroded_mass.csv (whose discharge is
+/// the --inflow series' at each row's time) and bed.png.
+#[test]
+fn a_flume_run_writes_bed_profile_eroded_mass_and_the_bed_plot() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = scratch("flume_run");
+    let out_dir = dir.join("out");
+    let series = dir.join("q.csv");
+    fs::write(&series, "t_s,q_m3_per_s\n0,0.0005\n0.02,0.0006\n").unwrap();
+    let out = flume_twin(&[
+        "simulate",
+        repo_file("solver/tests/cases/recycle_2d.yaml")
+            .to_str()
+            .unwrap(),
+        "--until",
+        "0.05",
+        "--no-snapshots",
+        "--inflow",
+        series.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stdout = text(&out.stdout);
+    assert!(
+        out.status.success(),
+        "simulate failed: {}\n{stdout}",
+        text(&out.stderr)
+    );
+    let eroded = fs::read_to_string(out_dir.join("eroded_mass.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = eroded
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{eroded}");
+    assert_eq!((rows[0][0], rows[0][1]), ("0", "0.0005"), "{eroded}");
+    assert_eq!((rows[1][0], rows[1][1]), ("0.05", "0.0006"), "{eroded}");
+    let bed = fs::read_to_string(out_dir.join("bed_profile.csv")).unwrap();
+    assert!(bed.starts_with("time_s,x_m,zb_m,zs_m,zw_m\n"), "{bed}");
+    let png = fs::read(out_dir.join("bed.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(stdout.contains("bed plot: "), "{stdout}");
+}

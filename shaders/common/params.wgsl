@@ -49,6 +49,10 @@ struct Flume {
     parking_x0: f32,         // spot of particle id k: x0 + (k % cols) dp, y0 + (k / cols) dp
     parking_y0: f32,
     parking_dp: f32,
+    duct_x_min: f32,         // a bottom outlet's duct: water with x >= duct_x_min and
+    duct_y_min: f32,         // duct_y_min < y <= duct_y_max moves at duct_u, m/s (a valve);
+    duct_y_max: f32,         // an empty box (duct_y_max = duct_y_min) when there is none
+    duct_u: f32,
     pad: f32,
 }
 

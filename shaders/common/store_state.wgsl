@@ -24,13 +24,6 @@ fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
     }
 }
 
-// Whether a particle at `x` is in the inlet buffer, whose velocity is imposed: behind the
-// buffer's face, in the opening. Water that wanders in is pushed out with the buffer.
-fn in_inlet(x: vec3<f32>) -> bool {
-    let f = params.flume;
-    return f.enabled != 0u && x.x < f.inlet_x_face && x.y > f.inlet_y_min && x.y <= f.inlet_y_max;
-}
-
 // Parks particle i (id `id`) at its spot as water; counts it as eroded when it was sediment
 // (that reached the collector, or left over the weir).
 fn park(i: u32, id: u32, eroded: bool) {
@@ -51,7 +44,8 @@ fn park(i: u32, id: u32, eroded: bool) {
 // state). Walls (DBC) keep their position and velocity, and their density never drops below
 // rho0 so that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest.
 // In an open flume: parked particles stay parked; fluid past the outlet and sediment in the
-// collector are parked; the inlet buffer moves at the inlet velocity, at its density.
+// collector are parked; the inlet buffer moves at the inlet velocity, at its density; water in
+// a bottom outlet's duct moves at the valve's velocity.
 fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase) {
     let phase = bitcast<u32>(p.w);
     let f = params.flume;
@@ -73,6 +67,15 @@ fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: ve
             positions_out[i] = vec4<f32>(moved, p.w);
             vel_rho_out[i] = vec4<f32>(u, vr.w);
             check_health(moved, u, vr.w, ph.rho0);
+            return;
+        }
+        if (phase == f.water_phase && in_duct(p.xyz)) {
+            let u = vec3<f32>(f.duct_u, 0.0, 0.0);
+            let moved = p.xyz + state.dt * u;
+            let r = select(rho, max(rho, ph.rho0), params.clamp_pressure != 0u);
+            positions_out[i] = vec4<f32>(moved, p.w);
+            vel_rho_out[i] = vec4<f32>(u, r);
+            check_health(moved, u, r, ph.rho0);
             return;
         }
     }

@@ -141,7 +141,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (mobile_i) {
         acc += params.gravity.xyz;
         let a = length(acc);
-        if (a > 0.0) {
+        if (a > 0.0 && !(flume && velocity_imposed(pos_i.xyz, phase_i))) {
             dt_i = sqrt(h / a);
         }
         dt_i = min(dt_i, h / (params.c0 + visc_max));

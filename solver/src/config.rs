@@ -74,6 +74,10 @@ pub struct OpenFlume {
     pub outlet_weir_m: f64,
     /// Sediment entering this box is eroded: counted, and recycled as water.
     pub collector: CollectorConfig,
+    /// A regulated bottom outlet (an orifice behind which a valve sets the velocity), for a
+    /// reservoir flushed through its downstream wall; absent for a flume that spills over its weir.
+    #[serde(default)]
+    pub bottom_outlet: Option<BottomOutlet>,
     /// Water particles parked at the start, for the inlet to draw on before any has left.
     pub reservoir_particles: u32,
 }
@@ -92,6 +96,18 @@ pub struct InletConfig {
 
 fn default_inlet_layers() -> u32 {
     4
+}
+
+/// The duct behind a bottom outlet: water with x >= `x_min_m` and `y_min_m` < y <= `y_max_m`
+/// moves downstream at `velocity_m_s`, so the discharge is velocity x (y_max - y_min) x width
+/// whatever the head, as a valve sets it. The duct's floor and roof are wall blocks.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BottomOutlet {
+    pub x_min_m: f64,
+    pub y_min_m: f64,
+    pub y_max_m: f64,
+    pub velocity_m_s: f64,
 }
 
 /// A box, m: x from `x_min_m` to `x_max_m`, below `y_max_m`.
@@ -556,6 +572,31 @@ impl Case {
                 "collector",
                 "must be a box inside the flume (x_min < x_max, above the floor)".into(),
             );
+        }
+        if let Some(o) = &f.bottom_outlet {
+            if !(o.x_min_m > lo[0] && o.x_min_m < hi[0]) {
+                return err("bottom_outlet.x_min_m", "must lie inside the flume".into());
+            }
+            if !(o.y_min_m >= lo[1] && o.y_max_m - o.y_min_m >= dp && o.y_max_m <= hi[1]) {
+                return err(
+                    "bottom_outlet.y_max_m",
+                    "the opening must be at least dp high, within the domain's height".into(),
+                );
+            }
+            if !positive(o.velocity_m_s) {
+                return err("bottom_outlet.velocity_m_s", "must be positive".into());
+            }
+            // The rest of the case is valid by now, so its sound speed can be derived.
+            let limit = crate::flume::MAX_INLET_MACH * crate::case::derive(self).c0;
+            if o.velocity_m_s > limit {
+                return err(
+                    "bottom_outlet.velocity_m_s",
+                    format!(
+                        "must be at most {} c0 = {limit:.3} m/s, as the inlet's",
+                        crate::flume::MAX_INLET_MACH
+                    ),
+                );
+            }
         }
         // Sediment that starts in the collector would count as eroded at the first step.
         if let Some((k, _)) = self.sediment_phases() {

@@ -141,6 +141,7 @@ mod tests {
                     x_max_m: 2.5,
                     y_max_m: 0.05,
                 },
+                bottom_outlet: None,
                 reservoir_particles: 100,
             },
             inflow_m3_per_s: q,

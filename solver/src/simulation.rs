@@ -905,6 +905,10 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
         parking_x0: parking.x0 as f32,
         parking_y0: parking.y0 as f32,
         parking_dp: dp as f32,
+        duct_x_min: f.bottom_outlet.as_ref().map_or(0.0, |o| o.x_min_m) as f32,
+        duct_y_min: f.bottom_outlet.as_ref().map_or(0.0, |o| o.y_min_m) as f32,
+        duct_y_max: f.bottom_outlet.as_ref().map_or(0.0, |o| o.y_max_m) as f32,
+        duct_u: f.bottom_outlet.as_ref().map_or(0.0, |o| o.velocity_m_s) as f32,
         pad: 0.0,
     }
 }

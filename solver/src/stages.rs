@@ -30,6 +30,7 @@ const NEIGHBOUR_PASS: &[&str] = &[
     "common/step_state.wgsl",
     "common/chunk_idle.wgsl",
     "common/sediment.wgsl",
+    "common/flume.wgsl",
 ];
 const WITH_STATE: &[&str] = &["common/params.wgsl", "common/step_state.wgsl"];
 const HALF_STEP: &[&str] = &[
@@ -41,6 +42,7 @@ const FULL_STEP: &[&str] = &[
     "common/params.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
+    "common/flume.wgsl",
     "common/store_state.wgsl",
 ];
 

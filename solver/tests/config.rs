@@ -233,6 +233,42 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
     }
 }
 
+const FALAPPI: &str = include_str!("../../launch_configs/falappi_flushing.yaml");
+
+#[test]
+fn bottom_outlet_values_are_refused_with_field_and_reason() {
+    for (to, field, reason) in [
+        (
+            "bottom_outlet: { x_min_m: 2.0, y_min_m: 0.3, y_max_m: 0.36, velocity_m_s: -0.658 }",
+            "open_flume.bottom_outlet.velocity_m_s",
+            "positive",
+        ),
+        (
+            "bottom_outlet: { x_min_m: 2.0, y_min_m: 0.3, y_max_m: 0.305, velocity_m_s: 0.658 }",
+            "open_flume.bottom_outlet.y_max_m",
+            "at least dp",
+        ),
+        (
+            "bottom_outlet: { x_min_m: 2.5, y_min_m: 0.3, y_max_m: 0.36, velocity_m_s: 0.658 }",
+            "open_flume.bottom_outlet.x_min_m",
+            "inside the flume",
+        ),
+        // 0.3 c0 = 9 m/s, the inlet's bound.
+        (
+            "bottom_outlet: { x_min_m: 2.0, y_min_m: 0.3, y_max_m: 0.36, velocity_m_s: 9.5 }",
+            "open_flume.bottom_outlet.velocity_m_s",
+            "at most 0.3 c0",
+        ),
+    ] {
+        let from =
+            "bottom_outlet: { x_min_m: 2.0, y_min_m: 0.3, y_max_m: 0.36, velocity_m_s: 0.658 }";
+        assert!(FALAPPI.contains(from));
+        let (f, r) = refused(&FALAPPI.replace(from, to));
+        assert_eq!(f, field, "{to}: {r}");
+        assert!(r.contains(reason), "{to}: {r}");
+    }
+}
+
 #[test]
 fn an_open_flume_parks_its_reservoir_above_the_flow() {
     let c = launch_config("ulbra_flume.yaml");

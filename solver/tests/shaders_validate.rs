@@ -216,7 +216,11 @@ fn rust_mirrors_have_the_wgsl_layout() {
         collector_y_max,
         parking_x0,
         parking_y0,
-        parking_dp
+        parking_dp,
+        duct_x_min,
+        duct_y_min,
+        duct_y_max,
+        duct_u
     );
     let (m, size) = wgsl_layout(&module, "Sediment");
     assert_eq!(size as usize, size_of::<SedimentGpu>());

@@ -1,4 +1,6 @@
-//! Files a run leaves behind: the gauge time series (CSV) and particle snapshots (VTK).
+//! Files a run leaves behind: the gauge time series (CSV), particle snapshots (VTK) and the
+//! plot of the final bed (PNG).
 
+pub mod bed_plot;
 pub mod csv;
 pub mod vtk;

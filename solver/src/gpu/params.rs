@@ -60,6 +60,10 @@ pub struct FlumeGpu {
     pub parking_x0: f32,
     pub parking_y0: f32,
     pub parking_dp: f32,
+    pub duct_x_min: f32,
+    pub duct_y_min: f32,
+    pub duct_y_max: f32,
+    pub duct_u: f32,
     pub pad: f32,
 }
 

@@ -22,6 +22,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "common/store_state.wgsl",
     "common/sediment.wgsl",
     "common/chunk_idle.wgsl",
+    "common/flume.wgsl",
     "stages/grid_clear.wgsl",
     "stages/grid_count.wgsl",
     "stages/prefix_sum.wgsl",
