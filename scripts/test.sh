@@ -4,8 +4,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
-# An independent reader of our VTK snapshots, for the interop check in node/tests/cli.rs.
+# Independent readers: meshio for our VTK snapshots (node/tests/cli.rs), mcap-ros2-support's
+# ROS 2 decoder for our CDR messages (msgs/tests/cdr_interop.rs).
 if ! python3 -c "import meshio" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check meshio
+fi
+if ! python3 -c "import mcap_ros2" >/dev/null 2>&1; then
+  python3 -m pip install --quiet --disable-pip-version-check mcap mcap-ros2-support
 fi
 cargo test --release --workspace "$@"
