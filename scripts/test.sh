@@ -12,4 +12,8 @@ fi
 if ! python3 -c "import mcap_ros2" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check mcap mcap-ros2-support
 fi
+# A DDS nobody here wrote, for the ROS 2 interop test (node/tests/ros_interop.rs).
+if ! python3 -c "import cyclonedds" >/dev/null 2>&1; then
+  python3 -m pip install --quiet --disable-pip-version-check cyclonedds
+fi
 cargo test --release --workspace "$@"

@@ -1,6 +1,6 @@
 //! builtin_interfaces: time stamps and durations.
 
-use crate::{MsgDef, RosMessage};
+use crate::MsgDef;
 use serde::{Deserialize, Serialize};
 
 /// A point in time: seconds and nanoseconds (0 <= nanosec < 1e9).
@@ -31,13 +31,9 @@ pub static DURATION: MsgDef = MsgDef {
     uses: &[],
 };
 
-impl RosMessage for Time {
-    const DEF: &'static MsgDef = &TIME;
-}
+crate::ros_message!(Time, TIME);
 
-impl RosMessage for Duration {
-    const DEF: &'static MsgDef = &DURATION;
-}
+crate::ros_message!(Duration, DURATION);
 
 impl Time {
     /// The time `t_s` seconds after the epoch; None outside the i32 seconds range or when not

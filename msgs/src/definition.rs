@@ -42,6 +42,17 @@ pub trait RosMessage {
     const DEF: &'static MsgDef;
 }
 
+/// Declares a type the mirror of the ROS 2 type `def`, for us and for ros2-client.
+#[macro_export]
+macro_rules! ros_message {
+    ($t:ty, $def:expr) => {
+        impl $crate::RosMessage for $t {
+            const DEF: &'static $crate::MsgDef = &$def;
+        }
+        impl ros2_client::Message for $t {}
+    };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

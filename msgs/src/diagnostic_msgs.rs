@@ -1,7 +1,7 @@
 //! diagnostic_msgs: what `/diagnostics` carries.
 
+use crate::MsgDef;
 use crate::std_msgs::{self, Header};
-use crate::{MsgDef, RosMessage};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -54,14 +54,8 @@ pub static DIAGNOSTIC_ARRAY: MsgDef = MsgDef {
     uses: &[&std_msgs::HEADER, &DIAGNOSTIC_STATUS],
 };
 
-impl RosMessage for KeyValue {
-    const DEF: &'static MsgDef = &KEY_VALUE;
-}
+crate::ros_message!(KeyValue, KEY_VALUE);
 
-impl RosMessage for DiagnosticStatus {
-    const DEF: &'static MsgDef = &DIAGNOSTIC_STATUS;
-}
+crate::ros_message!(DiagnosticStatus, DIAGNOSTIC_STATUS);
 
-impl RosMessage for DiagnosticArray {
-    const DEF: &'static MsgDef = &DIAGNOSTIC_ARRAY;
-}
+crate::ros_message!(DiagnosticArray, DIAGNOSTIC_ARRAY);

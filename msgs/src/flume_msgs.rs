@@ -1,7 +1,7 @@
 //! flume_msgs: the twin's own types. Their definitions are the ROS package's `msg/*.msg` files.
 
+use crate::MsgDef;
 use crate::std_msgs::{self, Header};
-use crate::{MsgDef, RosMessage};
 use serde::{Deserialize, Serialize};
 
 /// Inflow discharge from the flume's flow meter.
@@ -98,26 +98,14 @@ pub static GAUGE_COMPARISON: MsgDef = MsgDef {
     uses: &[&std_msgs::HEADER, &GAUGE_RESIDUAL],
 };
 
-impl RosMessage for Discharge {
-    const DEF: &'static MsgDef = &DISCHARGE;
-}
+crate::ros_message!(Discharge, DISCHARGE);
 
-impl RosMessage for WaterLevel {
-    const DEF: &'static MsgDef = &WATER_LEVEL;
-}
+crate::ros_message!(WaterLevel, WATER_LEVEL);
 
-impl RosMessage for BedProfile {
-    const DEF: &'static MsgDef = &BED_PROFILE;
-}
+crate::ros_message!(BedProfile, BED_PROFILE);
 
-impl RosMessage for ErodedMass {
-    const DEF: &'static MsgDef = &ERODED_MASS;
-}
+crate::ros_message!(ErodedMass, ERODED_MASS);
 
-impl RosMessage for GaugeResidual {
-    const DEF: &'static MsgDef = &GAUGE_RESIDUAL;
-}
+crate::ros_message!(GaugeResidual, GAUGE_RESIDUAL);
 
-impl RosMessage for GaugeComparison {
-    const DEF: &'static MsgDef = &GAUGE_COMPARISON;
-}
+crate::ros_message!(GaugeComparison, GAUGE_COMPARISON);

@@ -1,6 +1,6 @@
 //! geometry_msgs: the points, orientations and vectors a marker is made of.
 
-use crate::{MsgDef, RosMessage};
+use crate::MsgDef;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -71,18 +71,10 @@ pub static VECTOR3: MsgDef = MsgDef {
     uses: &[],
 };
 
-impl RosMessage for Point {
-    const DEF: &'static MsgDef = &POINT;
-}
+crate::ros_message!(Point, POINT);
 
-impl RosMessage for Quaternion {
-    const DEF: &'static MsgDef = &QUATERNION;
-}
+crate::ros_message!(Quaternion, QUATERNION);
 
-impl RosMessage for Pose {
-    const DEF: &'static MsgDef = &POSE;
-}
+crate::ros_message!(Pose, POSE);
 
-impl RosMessage for Vector3 {
-    const DEF: &'static MsgDef = &VECTOR3;
-}
+crate::ros_message!(Vector3, VECTOR3);

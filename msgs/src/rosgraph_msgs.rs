@@ -1,7 +1,7 @@
 //! rosgraph_msgs: the simulated clock (`/clock`).
 
+use crate::MsgDef;
 use crate::builtin_interfaces::{self, Time};
-use crate::{MsgDef, RosMessage};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -16,6 +16,4 @@ pub static CLOCK: MsgDef = MsgDef {
     uses: &[&builtin_interfaces::TIME],
 };
 
-impl RosMessage for Clock {
-    const DEF: &'static MsgDef = &CLOCK;
-}
+crate::ros_message!(Clock, CLOCK);

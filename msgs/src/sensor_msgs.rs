@@ -1,8 +1,8 @@
 //! sensor_msgs: ultrasonic gauges (`Range`), particle clouds (`PointCloud2`), and the image a
 //! marker may carry.
 
+use crate::MsgDef;
 use crate::std_msgs::{self, Header};
-use crate::{MsgDef, RosMessage};
 use serde::{Deserialize, Serialize};
 
 /// A distance reading; a flume gauge's water level is its mount height minus `range`.
@@ -102,18 +102,10 @@ pub static COMPRESSED_IMAGE: MsgDef = MsgDef {
     uses: &[&std_msgs::HEADER],
 };
 
-impl RosMessage for Range {
-    const DEF: &'static MsgDef = &RANGE;
-}
+crate::ros_message!(Range, RANGE);
 
-impl RosMessage for PointField {
-    const DEF: &'static MsgDef = &POINT_FIELD;
-}
+crate::ros_message!(PointField, POINT_FIELD);
 
-impl RosMessage for PointCloud2 {
-    const DEF: &'static MsgDef = &POINT_CLOUD2;
-}
+crate::ros_message!(PointCloud2, POINT_CLOUD2);
 
-impl RosMessage for CompressedImage {
-    const DEF: &'static MsgDef = &COMPRESSED_IMAGE;
-}
+crate::ros_message!(CompressedImage, COMPRESSED_IMAGE);

@@ -1,7 +1,7 @@
 //! std_msgs: the header every stamped message starts with, and colours.
 
+use crate::MsgDef;
 use crate::builtin_interfaces::{self, Time};
-use crate::{MsgDef, RosMessage};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -33,10 +33,6 @@ pub static COLOR_RGBA: MsgDef = MsgDef {
     uses: &[],
 };
 
-impl RosMessage for Header {
-    const DEF: &'static MsgDef = &HEADER;
-}
+crate::ros_message!(Header, HEADER);
 
-impl RosMessage for ColorRGBA {
-    const DEF: &'static MsgDef = &COLOR_RGBA;
-}
+crate::ros_message!(ColorRGBA, COLOR_RGBA);

@@ -1,10 +1,10 @@
 //! visualization_msgs: the markers rviz draws (the bed and water lines).
 
+use crate::MsgDef;
 use crate::builtin_interfaces::{self, Duration};
 use crate::geometry_msgs::{self, Point, Pose, Vector3};
 use crate::sensor_msgs::{self, CompressedImage};
 use crate::std_msgs::{self, ColorRGBA, Header};
-use crate::{MsgDef, RosMessage};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -118,18 +118,10 @@ pub static MARKER_ARRAY: MsgDef = MsgDef {
     uses: &[&MARKER],
 };
 
-impl RosMessage for UVCoordinate {
-    const DEF: &'static MsgDef = &UV_COORDINATE;
-}
+crate::ros_message!(UVCoordinate, UV_COORDINATE);
 
-impl RosMessage for MeshFile {
-    const DEF: &'static MsgDef = &MESH_FILE;
-}
+crate::ros_message!(MeshFile, MESH_FILE);
 
-impl RosMessage for Marker {
-    const DEF: &'static MsgDef = &MARKER;
-}
+crate::ros_message!(Marker, MARKER);
 
-impl RosMessage for MarkerArray {
-    const DEF: &'static MsgDef = &MARKER_ARRAY;
-}
+crate::ros_message!(MarkerArray, MARKER_ARRAY);

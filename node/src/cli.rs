@@ -20,6 +20,50 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// Throughput (particle-steps/s) and real-time factor on this machine's adapter.
     Bench(BenchArgs),
+    /// The twin as a ROS 2 node: sensor topics in, bed profile, eroded mass, gauge comparison,
+    /// /clock and /diagnostics out. ROS arguments follow `--ros-args`, as ros2 run passes them.
+    Run(RunArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Case file (YAML) with an open flume, e.g. launch_configs/ulbra_flume.yaml.
+    pub case: PathBuf,
+    /// Real-time factor to run at when no sensor drives the twin (simulated s per wall s).
+    #[arg(long = "target-rtf", value_name = "X", default_value_t = 1.0, value_parser = positive)]
+    pub target_rtf: f64,
+    /// Most often the outputs are published, per wall second (the solver may report faster).
+    #[arg(long, value_name = "HZ", default_value_t = 2.0, value_parser = positive)]
+    pub publish_rate_hz: f64,
+    /// A sensor silent for this long is stale; the twin then runs on the clock, s.
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = positive)]
+    pub stale_after_s: f64,
+    /// Largest stretch of simulated time the solver runs between looks at the inputs, s.
+    #[arg(long, value_name = "S", default_value_t = 0.1, value_parser = positive)]
+    pub max_chunk_s: f64,
+    /// How far ahead of this machine's clock a sensor stamp may be (clock skew), s.
+    #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = positive)]
+    pub future_tolerance_s: f64,
+    /// DDS domain (as ROS_DOMAIN_ID).
+    #[arg(long, env = "ROS_DOMAIN_ID", default_value_t = 0)]
+    pub domain_id: u16,
+    /// Keep DDS on the loopback interface (tests, a single machine).
+    #[arg(long)]
+    pub loopback: bool,
+    /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Stop once simulated time reaches this, s (scripted runs and tests).
+    #[arg(long, value_name = "T_S", value_parser = positive)]
+    pub until: Option<f64>,
+}
+
+fn positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("must be a positive number, got {v}")),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 #[derive(Debug, Args)]

@@ -6,20 +6,35 @@
 mod bench;
 mod cli;
 mod inflow;
+mod inputs;
 mod output;
+mod pacer;
+mod ros_args;
+mod run;
 mod simulate;
+mod solver_thread;
 mod table;
 
 use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = cli::Cli::parse();
+    // ROS tools append `--ros-args ...`; it is ROS's grammar, not ours, so it goes around clap.
+    let mut args: Vec<String> = std::env::args().collect();
+    let ros_args = match args.iter().position(|a| a == "--ros-args") {
+        Some(k) => args.split_off(k),
+        None => Vec::new(),
+    };
+    let cli = cli::Cli::parse_from(args);
     // Warnings by default so a CI log shows solver trouble without drowning in detail.
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("warn,rustdds=error"),
+    )
+    .init();
     let result = match cli.command {
         cli::Command::Simulate(args) => simulate::run(&args),
         cli::Command::Bench(args) => bench::run(&args),
+        cli::Command::Run(args) => run::run(&args, &ros_args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

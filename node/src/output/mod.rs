@@ -3,4 +3,5 @@
 
 pub mod bed_plot;
 pub mod csv;
+pub mod recorder;
 pub mod vtk;

@@ -1,0 +1,135 @@
+//! The files a run writes as it goes (`simulate`, and `run --out`): gauges.csv, profile.csv,
+//! bed_profile.csv, eroded_mass.csv and particle snapshots.
+
+use crate::output::{
+    csv::{BedProfileCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
+    vtk,
+};
+use anyhow::{Context, Result};
+use flume_solver::{Case, Observations, Simulation};
+use std::fs::{self, File};
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Creates `dir/name` and writes its header with `start`.
+fn create_csv<T>(
+    dir: &Path,
+    name: &str,
+    start: impl FnOnce(BufWriter<File>) -> std::io::Result<T>,
+) -> Result<(PathBuf, T)> {
+    let path = dir.join(name);
+    let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+    let csv =
+        start(BufWriter::new(file)).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok((path, csv))
+}
+
+/// The files of a run: gauges.csv gets a row per output interval, and every
+/// `snapshot_every`-th interval k a snapshot `particles_kkkk.vtk`.
+pub struct Recorder {
+    dir: PathBuf,
+    csv_path: PathBuf,
+    csv: GaugeCsv<BufWriter<File>>,
+    /// profile.csv, when the case asks for a layer profile.
+    profile: Option<(PathBuf, ProfileCsv<BufWriter<File>>)>,
+    /// bed_profile.csv, when the case has a sediment and a profile.
+    bed_profile: Option<(PathBuf, BedProfileCsv<BufWriter<File>>)>,
+    /// eroded_mass.csv, for an open flume.
+    eroded: Option<(PathBuf, ErodedMassCsv<BufWriter<File>>)>,
+    snapshot_every: Option<u64>,
+}
+
+impl Recorder {
+    /// Whether the run writes bed_profile.csv (a sediment and a profile).
+    pub fn has_bed_profile(&self) -> bool {
+        self.bed_profile.is_some()
+    }
+
+    pub fn create(dir: &Path, case: &Case, snapshot_every: Option<u64>) -> Result<Recorder> {
+        fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let csv_path = dir.join("gauges.csv");
+        let obs = &case.observations;
+        let gauges: Vec<String> = obs.gauges.iter().map(|g| g.name.clone()).collect();
+        let probes: Vec<String> = obs.pressure_probes.iter().map(|p| p.name.clone()).collect();
+        let file = File::create(&csv_path)
+            .with_context(|| format!("cannot create {}", csv_path.display()))?;
+        let csv = GaugeCsv::new(BufWriter::new(file), &gauges, &probes)
+            .with_context(|| format!("cannot write {}", csv_path.display()))?;
+        let profile = match &obs.profile {
+            None => None,
+            Some(_) => {
+                let phases: Vec<String> = case.phases.iter().map(|p| p.name.clone()).collect();
+                Some(create_csv(dir, "profile.csv", |w| {
+                    ProfileCsv::new(w, &phases)
+                })?)
+            }
+        };
+        let bed_profile = match (&obs.profile, case.sediment_phases()) {
+            (Some(_), Some(_)) => Some(create_csv(dir, "bed_profile.csv", BedProfileCsv::new)?),
+            _ => None,
+        };
+        let eroded = match &case.open_flume {
+            Some(_) => Some(create_csv(dir, "eroded_mass.csv", ErodedMassCsv::new)?),
+            None => None,
+        };
+        Ok(Recorder {
+            dir: dir.to_path_buf(),
+            csv_path,
+            csv,
+            profile,
+            bed_profile,
+            eroded,
+            snapshot_every,
+        })
+    }
+
+    /// Observes the state after output interval `k` and writes what is due.
+    pub fn record(&mut self, sim: &Simulation, k: u64) -> Result<Observations> {
+        let obs = sim
+            .observe()
+            .context("cannot read the observations back from the GPU")?;
+        self.csv
+            .row(&obs)
+            .with_context(|| format!("cannot write {}", self.csv_path.display()))?;
+        if let Some((path, csv)) = &mut self.profile {
+            csv.rows(&obs)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let Some((path, csv)) = &mut self.bed_profile {
+            csv.rows(&obs)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if let Some((path, csv)) = &mut self.eroded {
+            csv.row(&obs)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        if self.snapshot_every.is_some_and(|n| k.is_multiple_of(n)) {
+            self.snapshot(sim, &format!("particles_{k:04}.vtk"))?;
+        }
+        Ok(obs)
+    }
+
+    /// Writes to a temporary name first, so a crash never leaves a truncated snapshot behind.
+    pub fn snapshot(&self, sim: &Simulation, name: &str) -> Result<()> {
+        let particles = sim
+            .read_particles()
+            .context("cannot read the particles back from the GPU")?;
+        let regions = sim
+            .regions()
+            .context("cannot read the particle regions back from the GPU")?;
+        let path = self.dir.join(name);
+        let tmp = self.dir.join(format!("{name}.part"));
+        let title = format!(
+            "flume-twin {} t = {} s step {}",
+            sim.case().name,
+            sim.time_s(),
+            sim.steps()
+        );
+        let file =
+            File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+        vtk::write_particles(BufWriter::new(file), &title, &particles, &regions)
+            .and_then(|()| fs::rename(&tmp, &path))
+            .with_context(|| format!("cannot write {}", path.display()))
+    }
+}

@@ -1,0 +1,563 @@
+//! `flume-twin run CASE [--ros-args ...]`: the twin as a ROS 2 node (ros2-client on tokio).
+//!
+//! Sensor samples come in on `inflow` and `gauges/<name>`, pass the input gate, and set how
+//! far the pacer lets the solver run; the solver runs on its own thread; its observations go
+//! out as the bed profile, the eroded mass, the gauge comparison, `/clock` and, once a
+//! second, `/diagnostics`. This module knows topics and times, not SPH.
+
+use crate::cli::RunArgs;
+use crate::inputs::{InputGate, Limits};
+use crate::pacer::Pacer;
+use crate::ros_args::{ParamValue, RosArgs};
+use crate::solver_thread::{self, Command, Report};
+use anyhow::{Context as _, Result, anyhow, bail};
+use flume_msgs::builtin_interfaces::Time;
+use flume_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
+use flume_msgs::flume_msgs::{
+    BedProfile, Discharge, ErodedMass, GaugeComparison, GaugeResidual, WaterLevel,
+};
+use flume_msgs::rosgraph_msgs::Clock;
+use flume_msgs::std_msgs::Header;
+use flume_msgs::{MsgDef, RosMessage};
+use flume_solver::{Case, Observations};
+use futures::StreamExt;
+use ros2_client::dds::rustdds::DomainParticipantBuilder;
+use ros2_client::qos::{Durability, History, WhenFull};
+use ros2_client::{
+    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher, QosProfile,
+    Subscription,
+};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use std::net::Ipv4Addr;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// The node's clock: ROS time, seconds since the epoch.
+fn now_s() -> f64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
+}
+
+fn reliable(depth: usize) -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::DEFAULT)
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth })
+}
+
+fn sensor_data() -> QosProfile {
+    QosProfile::subscription_default()
+        .reliability_best_effort()
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 5 })
+}
+
+fn type_name(def: &MsgDef) -> MessageTypeName {
+    MessageTypeName::new(def.package, def.name)
+}
+
+/// A topic name after the remaps, as ros2-client takes it.
+fn topic_name(ros: &RosArgs, name: &str) -> Result<Name> {
+    let remapped = ros.remap(name);
+    Name::parse(&remapped).map_err(|e| anyhow!("topic {remapped:?}: {e}"))
+}
+
+fn publisher<M: RosMessage + Serialize>(
+    node: &mut Node,
+    ros: &RosArgs,
+    name: &str,
+    qos: QosProfile,
+) -> Result<Publisher<M>> {
+    let topic = node
+        .create_topic(&topic_name(ros, name)?, type_name(M::DEF), &qos)
+        .with_context(|| format!("cannot create topic {name}"))?;
+    node.create_publisher::<M>(&topic, Some(qos))
+        .with_context(|| format!("cannot publish {name}"))
+}
+
+fn subscription<M: RosMessage + DeserializeOwned + 'static>(
+    node: &mut Node,
+    ros: &RosArgs,
+    name: &str,
+    qos: QosProfile,
+) -> Result<Subscription<M>> {
+    let topic = node
+        .create_topic(&topic_name(ros, name)?, type_name(M::DEF), &qos)
+        .with_context(|| format!("cannot create topic {name}"))?;
+    node.create_subscription::<M>(&topic, Some(qos))
+        .with_context(|| format!("cannot subscribe to {name}"))
+}
+
+/// Settings of a run, from the command line, then parameter files and `-p` (which win).
+#[derive(Debug, Clone)]
+struct Settings {
+    target_rtf: f64,
+    publish_rate_hz: f64,
+    stale_after_s: f64,
+    frame_id: String,
+}
+
+impl Settings {
+    fn new(args: &RunArgs, params: &[(String, ParamValue)]) -> Result<Settings> {
+        let mut s = Settings {
+            target_rtf: args.target_rtf,
+            publish_rate_hz: args.publish_rate_hz,
+            stale_after_s: args.stale_after_s,
+            frame_id: "flume".into(),
+        };
+        for (name, value) in params {
+            let number = || {
+                value
+                    .as_f64()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .ok_or_else(|| {
+                        anyhow!("parameter {name}: must be a positive number, got {value:?}")
+                    })
+            };
+            match name.as_str() {
+                "target_real_time_factor" => s.target_rtf = number()?,
+                "publish_rate_hz" => s.publish_rate_hz = number()?,
+                "stale_after_s" => s.stale_after_s = number()?,
+                "frame_id" => match value {
+                    ParamValue::String(f) => s.frame_id = f.clone(),
+                    other => bail!("parameter frame_id: must be a string, got {other:?}"),
+                },
+                "use_sim_time" => {}
+                other => log::warn!("parameter {other} is not one of flume_twin's; ignored"),
+            }
+        }
+        Ok(s)
+    }
+}
+
+/// A gauge's accepted readings, oldest first, from the one in force at the last output on.
+#[derive(Debug, Clone, Default)]
+struct Readings(std::collections::VecDeque<(f64, f64)>);
+
+impl Readings {
+    fn push(&mut self, stamp_s: f64, level_m: f64) {
+        self.0.push_back((stamp_s, level_m));
+    }
+
+    /// The newest stamp heard, s.
+    fn newest(&self) -> Option<f64> {
+        self.0.back().map(|r| r.0)
+    }
+
+    /// The level in force at `t` (the last reading stamped at or before it), forgetting the
+    /// readings it supersedes: outputs come in time order.
+    fn at(&mut self, t: f64) -> Option<f64> {
+        while self.0.len() > 1 && self.0[1].0 <= t {
+            self.0.pop_front();
+        }
+        self.0.front().filter(|r| r.0 <= t).map(|r| r.1)
+    }
+}
+
+/// Runs the node until Ctrl-C (or `--until`).
+pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
+    let case = Case::from_path(&args.case).context("the case file was refused")?;
+    let Some(flume) = case.open_flume.clone() else {
+        bail!(
+            "{}: the twin needs an open flume (open_flume: in the case) for its inflow to drive",
+            args.case.display()
+        );
+    };
+    let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
+    let namespace = ros.namespace.clone().unwrap_or_else(|| "/".into());
+    let node_name = ros.node_name.clone().unwrap_or_else(|| "flume_twin".into());
+    let fqn = format!("{}/{node_name}", namespace.trim_end_matches('/'));
+    let settings = Settings::new(args, &ros.parameters(&fqn)?)?;
+    let derived = flume_solver::case::derive(&case);
+    let limits = Limits {
+        max_discharge_m3_per_s: flume_solver::flume::MAX_INLET_MACH
+            * derived.c0
+            * flume.inlet.height_m
+            * flume.width_m,
+        flume_height_m: case.domain.max_m[case.dim() - 1] - case.domain.min_m[case.dim() - 1],
+        future_tolerance_s: args.future_tolerance_s,
+    };
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .context("cannot start the async runtime")?;
+    runtime.block_on(serve(
+        args, case, ros, namespace, node_name, settings, limits,
+    ))
+}
+
+#[allow(clippy::too_many_arguments)]
+async fn serve(
+    args: &RunArgs,
+    case: Case,
+    ros: RosArgs,
+    namespace: String,
+    node_name: String,
+    settings: Settings,
+    limits: Limits,
+) -> Result<()> {
+    let gauge_names: Vec<String> = case
+        .observations
+        .gauges
+        .iter()
+        .map(|g| g.name.clone())
+        .collect();
+    let solver_thread::SolverThread {
+        commands,
+        mut reports,
+        adapter,
+        particles,
+        first,
+        handle,
+    } = solver_thread::spawn(case, args.out.clone())?;
+    println!("adapter: {adapter}\nparticles: {particles}\nnode: {namespace} {node_name}");
+
+    let context = if args.loopback {
+        let participant = DomainParticipantBuilder::new(args.domain_id)
+            .with_only_networks([Ipv4Addr::LOCALHOST])
+            .build()
+            .context("cannot start DDS on the loopback interface")?;
+        Context::from_domain_participant(participant)
+    } else {
+        Context::with_options(ros2_client::ContextOptions::new().domain_id(args.domain_id))
+    }
+    .context("cannot start ROS 2 (DDS)")?;
+    let mut node = context
+        .new_node(
+            NodeName::new(&namespace, &node_name)
+                .map_err(|e| anyhow!("node name {namespace} {node_name}: {e}"))?,
+            NodeOptions::new().enable_rosout(true),
+        )
+        .context("cannot create the ROS 2 node")?;
+    let spinner = node.spinner().context("cannot spin the node")?;
+    tokio::spawn(spinner.spin());
+
+    let inflow_sub = subscription::<Discharge>(&mut node, &ros, "inflow", reliable(10))?;
+    let gauge_subs = gauge_names
+        .iter()
+        .map(|g| {
+            subscription::<WaterLevel>(
+                &mut node,
+                &ros,
+                &format!("gauges/{}", g.to_lowercase()),
+                sensor_data(),
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let bed_pub = publisher::<BedProfile>(
+        &mut node,
+        &ros,
+        "bed_profile",
+        reliable(1).durability(Durability::TransientLocal),
+    )?;
+    let eroded_pub = publisher::<ErodedMass>(&mut node, &ros, "eroded_mass", reliable(10))?;
+    let compare_pub =
+        publisher::<GaugeComparison>(&mut node, &ros, "gauges/predicted", reliable(10))?;
+    let clock_pub = publisher::<Clock>(
+        &mut node,
+        &ros,
+        "/clock",
+        QosProfile::publisher_default()
+            .reliability_best_effort()
+            .history(History::KeepLast { depth: 1 }),
+    )?;
+    let diag_pub = publisher::<DiagnosticArray>(&mut node, &ros, "/diagnostics", reliable(10))?;
+
+    let mut inflow_stream = Box::pin(inflow_sub.async_stream());
+    let mut gauge_stream = futures::stream::select_all(
+        gauge_subs
+            .iter()
+            .enumerate()
+            .map(|(i, s)| Box::pin(s.async_stream().map(move |r| (i, r)))),
+    );
+    let mut gate = InputGate::new(limits);
+    let mut pacer = Pacer::new(settings.target_rtf, settings.stale_after_s);
+    let mut measured: Vec<Readings> = vec![Readings::default(); gauge_names.len()];
+    let mut sim_t = 0.0;
+    let mut in_flight = false;
+    let mut undecodable = 0u64;
+    let mut solver_refused = 0u64;
+    let mut published_outputs = 0u64;
+    let mut decimated_outputs = 0u64;
+    let mut last_publish: Option<Instant> = None;
+    let mut last_obs: Observations = first;
+    let mut period = Period::new(sim_t);
+    let mut tick = tokio::time::interval(Duration::from_millis(20));
+    let mut diag_tick = tokio::time::interval(Duration::from_secs(1));
+    let until = args.until;
+    let mut shutdown = Box::pin(tokio::signal::ctrl_c());
+    loop {
+        tokio::select! {
+            _ = &mut shutdown => {
+                println!("interrupted at t = {sim_t:.3} s");
+                break;
+            }
+            Some(r) = inflow_stream.next() => match r {
+                Ok((msg, _)) => {
+                    let stamp = msg.header.stamp.as_secs_f64();
+                    if gate.discharge("inflow", stamp, msg.discharge_m3_per_s, now_s()).is_ok() {
+                        pacer.inflow(stamp, msg.discharge_m3_per_s);
+                    }
+                }
+                Err(e) => {
+                    undecodable += 1;
+                    log::warn!("inflow: a sample could not be read: {e:?}");
+                }
+            },
+            Some((g, r)) = gauge_stream.next() => match r {
+                Ok((msg, _)) => {
+                    let stamp = msg.header.stamp.as_secs_f64();
+                    let name = &gauge_names[g];
+                    if gate.level(name, stamp, msg.level_m, now_s()).is_ok() {
+                        pacer.heard(stamp);
+                        measured[g].push(stamp, msg.level_m);
+                    }
+                }
+                Err(e) => {
+                    undecodable += 1;
+                    log::warn!("gauge {}: a sample could not be read: {e:?}", gauge_names[g]);
+                }
+            },
+            Some(report) = reports.recv() => {
+                in_flight = false;
+                let report: Report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
+                sim_t = report.obs.time_s;
+                solver_refused += report.refused_inflows;
+                period.add(&report);
+                let origin = pacer.origin().unwrap_or_else(now_s);
+                let stamp = Time::from_secs_f64(origin + sim_t).unwrap_or_default();
+                let header = Header { stamp, frame_id: settings.frame_id.clone() };
+                publish(&clock_pub, Clock { clock: stamp }).await;
+                // Outputs are decimated to the publish rate when the solver reports faster;
+                // inputs never are.
+                let due = last_publish
+                    .is_none_or(|t| t.elapsed().as_secs_f64() >= 1.0 / settings.publish_rate_hz);
+                let last = until.is_some_and(|u| sim_t >= u);
+                if due || last {
+                    last_publish = Some(Instant::now());
+                    published_outputs += 1;
+                    let now = now_s();
+                    let stale: Vec<bool> = measured
+                        .iter()
+                        .map(|m| m.newest().is_none_or(|t| now - t > settings.stale_after_s))
+                        .collect();
+                    // Each gauge against its reading at the output's own time.
+                    let at: Vec<Option<f64>> =
+                        measured.iter_mut().map(|m| m.at(origin + sim_t)).collect();
+                    publish(&bed_pub, bed_profile(&report.obs, header.clone())).await;
+                    if let Some(msg) = eroded_mass(&report.obs, header.clone()) {
+                        publish(&eroded_pub, msg).await;
+                    }
+                    publish(&compare_pub, comparison(&report.obs, &at, &stale, header)).await;
+                } else {
+                    decimated_outputs += 1;
+                }
+                last_obs = report.obs;
+                if last {
+                    println!("reached t = {sim_t:.3} s (--until)");
+                    break;
+                }
+            }
+            _ = tick.tick() => {
+                if !in_flight {
+                    let now = now_s();
+                    let mut cap = args.max_chunk_s;
+                    if let Some(u) = until {
+                        cap = cap.min(u - sim_t);
+                    }
+                    if let Some(chunk) = pacer.next_chunk(sim_t, now, cap).filter(|_| cap > 0.0) {
+                        commands
+                            .send(Command::Advance { to_s: chunk.to_s, inflow: chunk.inflow })
+                            .map_err(|_| anyhow!("the solver thread has stopped"))?;
+                        in_flight = true;
+                    }
+                }
+            }
+            _ = diag_tick.tick() => {
+                let now = now_s();
+                let stale: Vec<&str> = gauge_names
+                    .iter()
+                    .zip(&measured)
+                    .filter(|(_, m)| m.newest().is_none_or(|t| now - t > settings.stale_after_s))
+                    .map(|(n, _)| n.as_str())
+                    .collect();
+                let lag = pacer.lag(sim_t, now);
+                let (rtf, step_rate, busy) = period.take(sim_t);
+                let mut values = vec![
+                    ("sim_time_s", format!("{sim_t:.6}")),
+                    ("real_time_factor", format!("{rtf:.4}")),
+                    ("target_real_time_factor", format!("{}", settings.target_rtf)),
+                    ("lag_s", format!("{lag:.3}")),
+                    ("step_rate_hz", format!("{step_rate:.1}")),
+                    ("particles", particles.to_string()),
+                    ("adapter", adapter.clone()),
+                    ("solver_busy_fraction", format!("{busy:.3}")),
+                    ("sensor_driven", pacer.sensor_driven(now).to_string()),
+                    ("stale_sensors", stale.join(",")),
+                    ("rejected_inputs", gate.refused_total().to_string()),
+                    ("undecodable_inputs", undecodable.to_string()),
+                    ("solver_refused_inflows", solver_refused.to_string()),
+                    ("late_inputs", pacer.late_inputs.to_string()),
+                    ("published_outputs", published_outputs.to_string()),
+                    ("decimated_outputs", decimated_outputs.to_string()),
+                    ("recoveries", last_obs.recoveries.to_string()),
+                ];
+                for (k, n) in gate.refused() {
+                    values.push((k, n.to_string()));
+                }
+                let behind = lag > 1.0;
+                let level = if behind || !stale.is_empty() {
+                    DiagnosticStatus::WARN
+                } else {
+                    DiagnosticStatus::OK
+                };
+                let message = match (behind, stale.is_empty()) {
+                    (true, _) => format!("{lag:.1} s behind the sensors: outputs decimated"),
+                    (false, false) => format!("stale sensors: {}", stale.join(", ")),
+                    (false, true) => "running".to_string(),
+                };
+                let stamp = Time::from_secs_f64(now).unwrap_or_default();
+                publish(&diag_pub, DiagnosticArray {
+                    header: Header { stamp, frame_id: String::new() },
+                    status: vec![DiagnosticStatus {
+                        level,
+                        name: format!("{node_name}: twin"),
+                        message,
+                        hardware_id: adapter.clone(),
+                        values: values
+                            .into_iter()
+                            .map(|(k, v)| KeyValue { key: k.to_string(), value: v })
+                            .collect(),
+                    }],
+                }).await;
+            }
+        }
+    }
+    drop(commands);
+    // The solver finishes its chunk and sees the closed channel.
+    if handle.join().is_err() {
+        log::warn!("the solver thread panicked");
+    }
+    Ok(())
+}
+
+async fn publish<M: Serialize + std::fmt::Debug>(publisher: &Publisher<M>, msg: M) {
+    if let Err(e) = publisher.async_publish(msg).await {
+        log::warn!("a message could not be published: {e:?}");
+    }
+}
+
+/// Simulated time, steps and solver time over the last diagnostics period.
+struct Period {
+    started: Instant,
+    sim_t0: f64,
+    steps: u64,
+    busy_s: f64,
+}
+
+impl Period {
+    fn new(sim_t: f64) -> Period {
+        Period {
+            started: Instant::now(),
+            sim_t0: sim_t,
+            steps: 0,
+            busy_s: 0.0,
+        }
+    }
+
+    fn add(&mut self, report: &Report) {
+        self.steps += report.steps;
+        self.busy_s += report.wall_s;
+    }
+
+    /// (achieved real-time factor, steps per second, fraction of the time the solver ran)
+    /// since the last call.
+    fn take(&mut self, sim_t: f64) -> (f64, f64, f64) {
+        let wall = self.started.elapsed().as_secs_f64().max(1e-9);
+        let out = (
+            (sim_t - self.sim_t0) / wall,
+            self.steps as f64 / wall,
+            self.busy_s / wall,
+        );
+        *self = Period::new(sim_t);
+        out
+    }
+}
+
+fn nan_if_none(v: Option<f64>) -> f64 {
+    v.unwrap_or(f64::NAN)
+}
+
+fn bed_profile(obs: &Observations, header: Header) -> BedProfile {
+    let bed = |f: fn(&flume_solver::observe::BedInterfaces) -> Option<f64>| -> Vec<f64> {
+        obs.profile
+            .iter()
+            .map(|c| nan_if_none(c.bed.as_ref().and_then(f)))
+            .collect()
+    };
+    BedProfile {
+        header,
+        x_m: obs.profile.iter().map(|c| c.x_m).collect(),
+        zb_m: bed(|b| b.zb_m),
+        zs_m: bed(|b| b.zs_m),
+        zw_m: bed(|b| b.zw_m),
+    }
+}
+
+fn eroded_mass(obs: &Observations, header: Header) -> Option<ErodedMass> {
+    obs.flume.as_ref().map(|f| ErodedMass {
+        header,
+        eroded_kg_per_m: f.eroded_kg_per_m,
+        eroded_kg: f.eroded_kg,
+        rate_kg_per_s: f.eroded_rate_kg_per_s,
+        particles: f.eroded_particles,
+    })
+}
+
+fn comparison(
+    obs: &Observations,
+    measured: &[Option<f64>],
+    stale: &[bool],
+    header: Header,
+) -> GaugeComparison {
+    GaugeComparison {
+        header,
+        gauges: obs
+            .gauges
+            .iter()
+            .zip(measured.iter().zip(stale))
+            .map(|(g, (m, &stale))| {
+                let predicted = nan_if_none(g.level_m);
+                let measured = nan_if_none(*m);
+                GaugeResidual {
+                    name: g.name.clone(),
+                    predicted_m: predicted,
+                    measured_m: measured,
+                    residual_m: predicted - measured,
+                    stale,
+                }
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gauge_is_compared_with_its_reading_at_the_output_time() {
+        let mut r = Readings::default();
+        assert_eq!(r.at(1.0), None, "no reading yet");
+        r.push(1.0, 0.07);
+        r.push(1.2, 0.08);
+        r.push(1.4, 0.09);
+        assert_eq!(r.at(0.5), None, "before the first reading");
+        assert_eq!(r.at(1.1), Some(0.07));
+        assert_eq!(r.at(1.3), Some(0.08));
+        assert_eq!(r.newest(), Some(1.4));
+        assert_eq!(r.at(2.0), Some(0.09));
+        assert_eq!(r.0.len(), 1, "superseded readings are forgotten");
+    }
+}

@@ -1,0 +1,154 @@
+//! The solver on a thread of its own: GPU work never blocks the async runtime. The node sends
+//! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
+
+use crate::output::recorder::Recorder;
+use anyhow::{Context, Result};
+use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+use std::time::Instant;
+use tokio::sync::mpsc as async_mpsc;
+
+pub enum Command {
+    Advance { to_s: f64, inflow: Vec<(f64, f64)> },
+}
+
+/// What a chunk did.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub obs: Observations,
+    /// Wall time the chunk took, s.
+    pub wall_s: f64,
+    /// Steps the chunk took.
+    pub steps: u64,
+    /// Discharges the solver refused in this chunk (each also logged).
+    pub refused_inflows: u64,
+}
+
+/// The solver thread's end of the channels, and what it says when it starts.
+pub struct SolverThread {
+    pub commands: mpsc::Sender<Command>,
+    pub reports: async_mpsc::UnboundedReceiver<Result<Report, String>>,
+    pub adapter: String,
+    pub particles: usize,
+    pub first: Observations,
+    pub handle: JoinHandle<()>,
+}
+
+/// Starts the solver for `case` on its own thread; returns once the GPU is open and the case
+/// built, with the observations at t = 0. With `out`, the thread writes the same CSV files as
+/// `simulate`, one row per chunk.
+pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
+    let (cmd_tx, cmd_rx) = mpsc::channel::<Command>();
+    let (rep_tx, rep_rx) = async_mpsc::unbounded_channel();
+    let (ready_tx, ready_rx) = mpsc::channel::<Result<(String, usize, Observations), String>>();
+    let handle = std::thread::Builder::new()
+        .name("flume-solver".into())
+        .spawn(move || {
+            let started = (|| -> Result<(Simulation, Option<Recorder>)> {
+                let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
+                let sim = Simulation::new(gpu, &case).context("cannot set up the simulation")?;
+                let recorder = match &out {
+                    Some(dir) => Some(Recorder::create(dir, &case, None)?),
+                    None => None,
+                };
+                Ok((sim, recorder))
+            })();
+            let (mut sim, mut recorder) = match started {
+                Ok(s) => s,
+                Err(e) => {
+                    let _ = ready_tx.send(Err(format!("{e:#}")));
+                    return;
+                }
+            };
+            let first = observe(&sim, recorder.as_mut(), 0);
+            let adapter = sim_adapter(&sim);
+            match first {
+                Ok(obs) => {
+                    let _ = ready_tx.send(Ok((adapter, sim.particle_count(), obs)));
+                }
+                Err(e) => {
+                    let _ = ready_tx.send(Err(e));
+                    return;
+                }
+            }
+            let mut k = 0;
+            while let Ok(Command::Advance { to_s, inflow }) = cmd_rx.recv() {
+                k += 1;
+                let report =
+                    run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
+                        observe(&sim, recorder.as_mut(), k).map(|obs| Report {
+                            obs,
+                            wall_s,
+                            steps,
+                            refused_inflows: refused,
+                        })
+                    });
+                let failed = report.is_err();
+                if rep_tx.send(report).is_err() || failed {
+                    return;
+                }
+            }
+        })
+        .context("cannot start the solver thread")?;
+    let (adapter, particles, first) = ready_rx
+        .recv()
+        .context("the solver thread stopped while starting")?
+        .map_err(|e| anyhow::anyhow!(e))?;
+    Ok(SolverThread {
+        commands: cmd_tx,
+        reports: rep_rx,
+        adapter,
+        particles,
+        first,
+        handle,
+    })
+}
+
+fn sim_adapter(sim: &Simulation) -> String {
+    sim.gpu().adapter.to_string()
+}
+
+fn observe(
+    sim: &Simulation,
+    recorder: Option<&mut Recorder>,
+    k: u64,
+) -> Result<Observations, String> {
+    match recorder {
+        Some(r) => r.record(sim, k).map_err(|e| format!("{e:#}")),
+        None => sim
+            .observe()
+            .map_err(|e| format!("cannot read the observations back from the GPU: {e}")),
+    }
+}
+
+/// Advances to `to_s`, setting each discharge at its time. A discharge the solver refuses
+/// (its inlet velocity above the Mach bound) is logged and counted; the previous one holds.
+fn run_chunk(
+    sim: &mut Simulation,
+    to_s: f64,
+    inflow: &[(f64, f64)],
+) -> Result<(f64, u64, u64), String> {
+    let started = Instant::now();
+    let steps0 = sim.steps();
+    let mut refused = 0;
+    for &(t, q) in inflow {
+        if t > sim.time_s() {
+            sim.advance_to(t).map_err(|e| format!("{e}"))?;
+        }
+        if let Err(e) = sim.set_boundary_conditions(BoundaryConditions { inflow_m3_per_s: q }) {
+            refused += 1;
+            log::warn!("discharge {q} m3/s at t = {t:.3} s refused by the solver: {e}");
+        }
+    }
+    if to_s > sim.time_s() {
+        sim.advance_to(to_s).map_err(|e| format!("{e}"))?;
+    }
+    Ok((
+        started.elapsed().as_secs_f64(),
+        sim.steps() - steps0,
+        refused,
+    ))
+}

@@ -1,0 +1,266 @@
+//! The twin as a ROS 2 node against a DDS nobody here wrote: a Python peer on Cyclone DDS
+//! (`tests/interop/dds_peer.py`) plays the sensors over loopback and records what the twin
+//! publishes; the values it receives must be the ones the solver produced (the node's own
+//! `--out` CSV files), and the bad samples it slips in must be refused and counted.
+
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::sync::{Mutex, MutexGuard};
+
+static GPU: Mutex<()> = Mutex::new(());
+
+fn repo_file(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(rel)
+}
+
+fn gpu() -> Option<MutexGuard<'static, ()>> {
+    let guard = GPU.lock().unwrap_or_else(|p| p.into_inner());
+    match flume_solver::GpuContext::new() {
+        Ok(_) => Some(guard),
+        Err(e) if std::env::var("CI").as_deref() == Ok("true") => {
+            panic!("CI=true and no GPU adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("note: skipping a GPU test, no adapter: {e}");
+            None
+        }
+    }
+}
+
+fn have_cyclonedds() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import cyclonedds"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "CI=true and no cyclonedds for python3 (scripts/test.sh installs it)"
+        );
+        eprintln!("note: skipping the DDS interop test: pip install cyclonedds");
+    }
+    ok
+}
+
+/// Rows of a CSV file as maps from column to value.
+fn csv_rows(path: &PathBuf) -> Vec<BTreeMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .expect("a header")
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(str::to_string))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+#[test]
+fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
+    let Some(_gpu) = gpu() else { return };
+    if !have_cyclonedds() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("flume-ros-interop-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out_dir = dir.join("out");
+    // The twin runs to 0.5 s of simulated time behind sensors that speak for 4 s; on a
+    // software adapter it lags them, so its lag and decimation show in /diagnostics.
+    let node = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+        .args([
+            "run",
+            repo_file("solver/tests/cases/recycle_2d.yaml")
+                .to_str()
+                .expect("utf-8"),
+            "--loopback",
+            "--until",
+            "0.5",
+            "--out",
+            out_dir.to_str().expect("utf-8"),
+            "--ros-args",
+            "-r",
+            "__ns:=/flume_test",
+            "-p",
+            "publish_rate_hz:=20.0",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the twin starts");
+    let peer = Command::new("python3")
+        .arg(repo_file("tests/interop/dds_peer.py"))
+        .args(["/flume_test", "4", "40"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the peer starts");
+    let node = node.wait_with_output().expect("the twin ends");
+    let node_log =
+        String::from_utf8_lossy(&node.stdout).to_string() + &String::from_utf8_lossy(&node.stderr);
+    assert!(node.status.success(), "the twin failed:\n{node_log}");
+    assert!(node_log.contains("reached t = 0.500 s"), "{node_log}");
+    // Once the twin is gone the peer has seen all it will: give the last samples a moment
+    // in flight, then stop it.
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let mut peer = peer;
+    let _ = peer.kill();
+    let peer = peer.wait_with_output().expect("the peer ends");
+    let peer_out = String::from_utf8_lossy(&peer.stdout).to_string();
+    let peer_err = String::from_utf8_lossy(&peer.stderr).to_string();
+    assert!(
+        !peer_err.contains("Traceback"),
+        "the peer failed: {peer_err}\n{peer_out}"
+    );
+    let particles = node_log
+        .lines()
+        .find_map(|l| l.strip_prefix("particles: "))
+        .expect("a particles line")
+        .to_string();
+    let mut got: BTreeMap<String, Vec<Value>> = BTreeMap::new();
+    for line in peer_out.lines() {
+        let v: Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{line}: {e}"));
+        let (k, body) = v
+            .as_object()
+            .and_then(|o| o.iter().next())
+            .expect("one key");
+        got.entry(k.clone()).or_default().push(body.clone());
+    }
+    let count = |k: &str| got.get(k).map_or(0, Vec::len);
+    eprintln!(
+        "peer: sent {}, received {} bed profiles, {} eroded masses, {} gauge comparisons, {} clocks, {} diagnostics",
+        count("sent"),
+        count("bed_profile"),
+        count("eroded_mass"),
+        count("predicted"),
+        count("clock"),
+        count("diagnostics")
+    );
+    let matched = &got["matched"][0];
+    assert!(
+        num(&matched["inflow"]) >= 1.0 && num(&matched["p1"]) >= 1.0,
+        "{matched}"
+    );
+
+    // The gauge comparison: predicted is the solver's P1 at that time (gauges.csv), measured
+    // one of the levels the peer sent, residual their difference.
+    let gauges = csv_rows(&out_dir.join("gauges.csv"));
+    let sent_levels: Vec<f64> = got["sent"].iter().map(|s| num(&s["level"])).collect();
+    let comparisons = &got["predicted"];
+    assert!(comparisons.len() >= 3, "{comparisons:?}");
+    // Simulated time 0 in the sensors' clock: the stamps are origin + t.
+    let t_first = num(&comparisons[0]["t"]);
+    let origin_candidates: Vec<f64> = gauges
+        .iter()
+        .map(|r| t_first - r["time_s"].parse::<f64>().expect("time"))
+        .collect();
+    let mut checked = 0;
+    for origin in origin_candidates {
+        let all_match = comparisons.iter().all(|c| {
+            let t = num(&c["t"]) - origin;
+            gauges.iter().any(|r| {
+                let (rt, p1): (f64, f64) = (
+                    r["time_s"].parse().expect("time"),
+                    r["P1_m"].parse().expect("level"),
+                );
+                (rt - t).abs() < 1e-6 && (p1 - num(&c["gauges"][0]["predicted"])).abs() < 1e-6
+            })
+        });
+        if all_match {
+            checked = comparisons.len();
+            break;
+        }
+    }
+    assert_eq!(
+        checked,
+        comparisons.len(),
+        "a predicted level is not the solver's at its time"
+    );
+    let mut measured_seen = 0;
+    for c in comparisons {
+        let g = &c["gauges"][0];
+        assert_eq!(g["name"], "P1");
+        if let Some(m) = g["measured"].as_f64() {
+            measured_seen += 1;
+            assert!(sent_levels.contains(&m), "measured {m} was never sent");
+            assert_eq!(num(&g["residual"]), num(&g["predicted"]) - m);
+        }
+    }
+    assert!(measured_seen > 0, "no comparison carried a measurement");
+
+    // The bed profile and eroded mass of the last output are the solver's last rows.
+    let bed = csv_rows(&out_dir.join("bed_profile.csv"));
+    let last_bed = got["bed_profile"].last().expect("a bed profile");
+    let last_t: f64 = bed.last().expect("rows")["time_s"].parse().expect("time");
+    let rows: Vec<_> = bed
+        .iter()
+        .filter(|r| r["time_s"].parse::<f64>().expect("time") == last_t)
+        .collect();
+    let xs: Vec<f64> = last_bed["x"]
+        .as_array()
+        .expect("x")
+        .iter()
+        .map(num)
+        .collect();
+    assert_eq!(xs.len(), rows.len());
+    for (k, r) in rows.iter().enumerate() {
+        assert!((xs[k] - r["x_m"].parse::<f64>().expect("x")).abs() < 1e-6);
+        let zs: f64 = r["zs_m"].parse().expect("zs");
+        assert!(
+            (num(&last_bed["zs"][k]) - zs).abs() < 1e-6,
+            "zs at {}",
+            xs[k]
+        );
+    }
+    let eroded = csv_rows(&out_dir.join("eroded_mass.csv"));
+    let last_eroded = got["eroded_mass"].last().expect("an eroded mass");
+    let csv_kg: f64 = eroded.last().expect("rows")["eroded_kg"]
+        .parse()
+        .expect("kg");
+    assert!((num(&last_eroded["kg"]) - csv_kg).abs() < 1e-9 * csv_kg.max(1.0));
+    let kgs: Vec<f64> = got["eroded_mass"].iter().map(|e| num(&e["kg"])).collect();
+    assert!(
+        kgs.windows(2).all(|w| w[1] >= w[0]),
+        "eroded mass went down: {kgs:?}"
+    );
+
+    // /clock runs forward; /diagnostics counts the refused samples by reason.
+    let clocks: Vec<f64> = got["clock"].iter().map(|c| num(&c["t"])).collect();
+    assert!(clocks.windows(2).all(|w| w[1] > w[0]), "{clocks:?}");
+    let diag = got["diagnostics"].last().expect("diagnostics");
+    let values = &diag["status"][0]["values"];
+    for (key, want) in [
+        ("non_finite", "1"),
+        ("negative_discharge", "1"),
+        ("level_outside_flume", "1"),
+        ("rejected_inputs", "3"),
+        ("particles", particles.as_str()),
+    ] {
+        assert_eq!(values[key], want, "{key} in {values}");
+    }
+    for key in [
+        "real_time_factor",
+        "lag_s",
+        "step_rate_hz",
+        "adapter",
+        "stale_sensors",
+    ] {
+        assert!(values.get(key).is_some(), "no {key} in {values}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
