@@ -35,6 +35,12 @@ pub struct RunArgs {
     /// Most often the outputs are published, per wall second (the solver may report faster).
     #[arg(long, value_name = "HZ", default_value_t = 2.0, value_parser = positive)]
     pub publish_rate_hz: f64,
+    /// Most often the particle cloud is published, per wall second.
+    #[arg(long, value_name = "HZ", default_value_t = 1.0, value_parser = positive)]
+    pub cloud_rate_hz: f64,
+    /// Most particles in a published cloud (every k-th particle is sent).
+    #[arg(long, value_name = "N", default_value_t = 20000)]
+    pub cloud_max_points: usize,
     /// A sensor silent for this long is stale; the twin then runs on the clock, s.
     #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = positive)]
     pub stale_after_s: f64,
@@ -44,6 +50,9 @@ pub struct RunArgs {
     /// How far ahead of this machine's clock a sensor stamp may be (clock skew), s.
     #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = positive)]
     pub future_tolerance_s: f64,
+    /// Hold at t = 0 until the first sensor sample: simulated time 0 is then the flume's start.
+    #[arg(long)]
+    pub wait_for_sensors: bool,
     /// DDS domain (as ROS_DOMAIN_ID).
     #[arg(long, env = "ROS_DOMAIN_ID", default_value_t = 0)]
     pub domain_id: u16,

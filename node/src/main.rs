@@ -14,6 +14,7 @@ mod run;
 mod simulate;
 mod solver_thread;
 mod table;
+mod visual;
 
 use clap::Parser;
 use std::process::ExitCode;

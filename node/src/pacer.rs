@@ -27,11 +27,13 @@ pub struct Pacer {
     pending: VecDeque<(f64, f64)>,
     pub target_rtf: f64,
     pub stale_after_s: f64,
+    /// Hold at t = 0 until the first sensor sample (the twin starts with the flume).
+    pub wait_for_sensors: bool,
     pub late_inputs: u64,
 }
 
 impl Pacer {
-    pub fn new(target_rtf: f64, stale_after_s: f64) -> Pacer {
+    pub fn new(target_rtf: f64, stale_after_s: f64, wait_for_sensors: bool) -> Pacer {
         Pacer {
             origin: None,
             newest: None,
@@ -39,6 +41,7 @@ impl Pacer {
             pending: VecDeque::new(),
             target_rtf,
             stale_after_s,
+            wait_for_sensors,
             late_inputs: 0,
         }
     }
@@ -75,6 +78,9 @@ impl Pacer {
     /// Simulated time the twin should have reached at node-clock time `now`, having reached
     /// `sim_t`.
     pub fn target(&mut self, sim_t: f64, now: f64) -> f64 {
+        if self.wait_for_sensors && self.newest.is_none() {
+            return sim_t;
+        }
         if self.sensor_driven(now) {
             let newest = self.newest.unwrap_or(now);
             return self.sim_time_of(newest).max(sim_t);
@@ -122,7 +128,7 @@ mod tests {
 
     #[test]
     fn sensors_drive_the_twin_to_their_newest_stamp_in_chunks() {
-        let mut p = Pacer::new(1.0, 2.0);
+        let mut p = Pacer::new(1.0, 2.0, false);
         p.inflow(100.0, 5e-4);
         p.heard(100.4);
         p.inflow(100.7, 6e-4);
@@ -144,7 +150,7 @@ mod tests {
 
     #[test]
     fn silent_sensors_hand_over_to_the_clock_times_the_factor() {
-        let mut p = Pacer::new(0.5, 1.0);
+        let mut p = Pacer::new(0.5, 1.0, false);
         p.inflow(10.0, 5e-4);
         p.heard(10.2);
         // At 11.5 the newest stamp is 1.3 s old: stale. The clock runs on from t = 0.2 s.
@@ -158,7 +164,7 @@ mod tests {
 
     #[test]
     fn with_no_sensors_the_clock_runs_from_the_start() {
-        let mut p = Pacer::new(2.0, 1.0);
+        let mut p = Pacer::new(2.0, 1.0, false);
         assert_eq!(p.next_chunk(0.0, 50.0, 1.0), None, "t = 0 at the start");
         let c = p.next_chunk(0.0, 50.25, 1.0).expect("runs");
         assert!((c.to_s - 0.5).abs() < 1e-9);
@@ -166,8 +172,21 @@ mod tests {
     }
 
     #[test]
+    fn waiting_for_sensors_holds_the_twin_at_zero_until_the_first_sample() {
+        let mut p = Pacer::new(1.0, 1.0, true);
+        assert_eq!(p.next_chunk(0.0, 50.0, 1.0), None);
+        assert_eq!(p.next_chunk(0.0, 60.0, 1.0), None, "still no sensor");
+        assert_eq!(p.origin(), None);
+        p.inflow(61.0, 1e-4);
+        p.heard(61.5);
+        assert_eq!(p.origin(), Some(61.0), "t = 0 is the first sample");
+        let c = p.next_chunk(0.0, 61.5, 1.0).expect("runs");
+        assert!((c.to_s - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
     fn a_late_discharge_is_applied_at_once_not_dropped() {
-        let mut p = Pacer::new(1.0, 5.0);
+        let mut p = Pacer::new(1.0, 5.0, false);
         p.inflow(0.0, 1e-4);
         p.heard(2.0);
         let _ = p.next_chunk(0.0, 2.0, 5.0);

@@ -10,6 +10,7 @@ use crate::inputs::{InputGate, Limits};
 use crate::pacer::Pacer;
 use crate::ros_args::{ParamValue, RosArgs};
 use crate::solver_thread::{self, Command, Report};
+use crate::visual;
 use anyhow::{Context as _, Result, anyhow, bail};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
@@ -17,7 +18,9 @@ use flume_msgs::flume_msgs::{
     BedProfile, Discharge, ErodedMass, GaugeComparison, GaugeResidual, WaterLevel,
 };
 use flume_msgs::rosgraph_msgs::Clock;
+use flume_msgs::sensor_msgs::PointCloud2;
 use flume_msgs::std_msgs::Header;
+use flume_msgs::visualization_msgs::MarkerArray;
 use flume_msgs::{MsgDef, RosMessage};
 use flume_solver::{Case, Observations};
 use futures::StreamExt;
@@ -263,6 +266,21 @@ async fn serve(
             .history(History::KeepLast { depth: 1 }),
     )?;
     let diag_pub = publisher::<DiagnosticArray>(&mut node, &ros, "/diagnostics", reliable(10))?;
+    let cloud_pub = publisher::<PointCloud2>(
+        &mut node,
+        &ros,
+        "particles",
+        QosProfile::publisher_default()
+            .reliability_best_effort()
+            .history(History::KeepLast { depth: 1 }),
+    )?;
+    let marker_pub = publisher::<MarkerArray>(
+        &mut node,
+        &ros,
+        "bed_marker",
+        reliable(1).durability(Durability::TransientLocal),
+    )?;
+    let mut last_cloud: Option<Instant> = None;
 
     let mut inflow_stream = Box::pin(inflow_sub.async_stream());
     let mut gauge_stream = futures::stream::select_all(
@@ -272,7 +290,11 @@ async fn serve(
             .map(|(i, s)| Box::pin(s.async_stream().map(move |r| (i, r)))),
     );
     let mut gate = InputGate::new(limits);
-    let mut pacer = Pacer::new(settings.target_rtf, settings.stale_after_s);
+    let mut pacer = Pacer::new(
+        settings.target_rtf,
+        settings.stale_after_s,
+        args.wait_for_sensors,
+    );
     let mut measured: Vec<Readings> = vec![Readings::default(); gauge_names.len()];
     let mut sim_t = 0.0;
     let mut in_flight = false;
@@ -329,6 +351,10 @@ async fn serve(
                 let stamp = Time::from_secs_f64(origin + sim_t).unwrap_or_default();
                 let header = Header { stamp, frame_id: settings.frame_id.clone() };
                 publish(&clock_pub, Clock { clock: stamp }).await;
+                if let Some(points) = &report.cloud {
+                    let cloud = visual::point_cloud(header.clone(), points, args.cloud_max_points);
+                    publish(&cloud_pub, cloud).await;
+                }
                 // Outputs are decimated to the publish rate when the solver reports faster;
                 // inputs never are.
                 let due = last_publish
@@ -345,7 +371,13 @@ async fn serve(
                     // Each gauge against its reading at the output's own time.
                     let at: Vec<Option<f64>> =
                         measured.iter_mut().map(|m| m.at(origin + sim_t)).collect();
-                    publish(&bed_pub, bed_profile(&report.obs, header.clone())).await;
+                    let bed = bed_profile(&report.obs, header.clone());
+                    publish(
+                        &marker_pub,
+                        visual::bed_lines(&header, &bed.x_m, &bed.zs_m, &bed.zw_m),
+                    )
+                    .await;
+                    publish(&bed_pub, bed).await;
                     if let Some(msg) = eroded_mass(&report.obs, header.clone()) {
                         publish(&eroded_pub, msg).await;
                     }
@@ -367,8 +399,13 @@ async fn serve(
                         cap = cap.min(u - sim_t);
                     }
                     if let Some(chunk) = pacer.next_chunk(sim_t, now, cap).filter(|_| cap > 0.0) {
+                        let cloud = last_cloud
+                            .is_none_or(|t| t.elapsed().as_secs_f64() >= 1.0 / args.cloud_rate_hz);
+                        if cloud {
+                            last_cloud = Some(Instant::now());
+                        }
                         commands
-                            .send(Command::Advance { to_s: chunk.to_s, inflow: chunk.inflow })
+                            .send(Command::Advance { to_s: chunk.to_s, inflow: chunk.inflow, cloud })
                             .map_err(|_| anyhow!("the solver thread has stopped"))?;
                         in_flight = true;
                     }

@@ -2,6 +2,7 @@
 //! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
 
 use crate::output::recorder::Recorder;
+use crate::visual::CloudPoint;
 use anyhow::{Context, Result};
 use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation};
 use std::path::PathBuf;
@@ -12,7 +13,13 @@ use std::time::Instant;
 use tokio::sync::mpsc as async_mpsc;
 
 pub enum Command {
-    Advance { to_s: f64, inflow: Vec<(f64, f64)> },
+    /// Advance to `to_s`, changing the discharge at each `(t, q)`; with `cloud`, read the
+    /// particles back for the visualisers.
+    Advance {
+        to_s: f64,
+        inflow: Vec<(f64, f64)>,
+        cloud: bool,
+    },
 }
 
 /// What a chunk did.
@@ -25,6 +32,8 @@ pub struct Report {
     pub steps: u64,
     /// Discharges the solver refused in this chunk (each also logged).
     pub refused_inflows: u64,
+    /// The particles in the flow (not the parked ones), when asked for.
+    pub cloud: Option<Vec<CloudPoint>>,
 }
 
 /// The solver thread's end of the channels, and what it says when it starts.
@@ -75,15 +84,30 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                 }
             }
             let mut k = 0;
-            while let Ok(Command::Advance { to_s, inflow }) = cmd_rx.recv() {
+            let parked = case
+                .open_flume
+                .as_ref()
+                .map(|_| flume_solver::case::parked_phase(&case));
+            while let Ok(Command::Advance {
+                to_s,
+                inflow,
+                cloud,
+            }) = cmd_rx.recv()
+            {
                 k += 1;
                 let report =
                     run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
+                        let cloud = if cloud {
+                            Some(cloud_points(&sim, parked)?)
+                        } else {
+                            None
+                        };
                         observe(&sim, recorder.as_mut(), k).map(|obs| Report {
                             obs,
                             wall_s,
                             steps,
                             refused_inflows: refused,
+                            cloud,
                         })
                     });
                 let failed = report.is_err();
@@ -151,4 +175,24 @@ fn run_chunk(
         sim.steps() - steps0,
         refused,
     ))
+}
+
+/// The particles in the flume frame (z up), without the parked ones.
+fn cloud_points(sim: &Simulation, parked: Option<u32>) -> Result<Vec<CloudPoint>, String> {
+    let p = sim
+        .read_particles()
+        .map_err(|e| format!("cannot read the particles back from the GPU: {e}"))?;
+    let two_d = sim.case().dim() == 2;
+    Ok((0..p.len())
+        .filter(|&i| Some(p.phase(i)) != parked)
+        .map(|i| {
+            let [x, y, z, _] = p.positions[i];
+            let [u, v, w, _] = p.vel_rho[i];
+            CloudPoint {
+                position: if two_d { [x, 0.0, y] } else { [x, y, z] },
+                speed: (u * u + v * v + w * w).sqrt(),
+                phase: u8::try_from(p.phase(i)).unwrap_or(u8::MAX),
+            }
+        })
+        .collect())
 }

@@ -89,6 +89,7 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
                 .to_str()
                 .expect("utf-8"),
             "--loopback",
+            "--wait-for-sensors",
             "--until",
             "0.5",
             "--out",
@@ -143,11 +144,13 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
     }
     let count = |k: &str| got.get(k).map_or(0, Vec::len);
     eprintln!(
-        "peer: sent {}, received {} bed profiles, {} eroded masses, {} gauge comparisons, {} clocks, {} diagnostics",
+        "peer: sent {}, received {} bed profiles, {} eroded masses, {} gauge comparisons, {} clouds, {} marker arrays, {} clocks, {} diagnostics",
         count("sent"),
         count("bed_profile"),
         count("eroded_mass"),
         count("predicted"),
+        count("particles"),
+        count("bed_marker"),
         count("clock"),
         count("diagnostics")
     );
@@ -238,6 +241,36 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
         kgs.windows(2).all(|w| w[1] >= w[0]),
         "eroded mass went down: {kgs:?}"
     );
+
+    // The particle cloud: x, y, z, speed (float32) and phase (uint8) of every particle in the
+    // flow (walls, water, sand; the parked ones left out), finite; the bed and water lines.
+    let cloud = got["particles"].last().expect("a particle cloud");
+    assert_eq!(
+        cloud["fields"],
+        serde_json::json!([
+            ["x", 0, 7],
+            ["y", 4, 7],
+            ["z", 8, 7],
+            ["speed", 12, 7],
+            ["phase", 16, 2]
+        ])
+    );
+    let width = num(&cloud["width"]);
+    assert!(
+        width > 0.0 && width <= particles.parse::<f64>().expect("count"),
+        "{cloud}"
+    );
+    assert_eq!(cloud["finite"], true);
+    assert_eq!(
+        cloud["phases"],
+        serde_json::json!([0, 1, 2]),
+        "walls, water, sand"
+    );
+    let markers = &got["bed_marker"].last().expect("bed lines")["markers"];
+    assert_eq!(markers[0]["ns"], "bed");
+    assert_eq!(markers[1]["ns"], "water");
+    assert_eq!(markers[0]["type"], 4, "LINE_STRIP");
+    assert!(num(&markers[1]["points"]) >= 1.0);
 
     // /clock runs forward; /diagnostics counts the refused samples by reason.
     let clocks: Vec<f64> = got["clock"].iter().map(|c| num(&c["t"])).collect();

@@ -6,7 +6,7 @@ It publishes, every 0.1 s of wall time for DURATION_S, a discharge on `<ns>/infl
 effort), each stamped with this machine's clock; in the middle it also sends what the twin must
 refuse (a NaN and a negative discharge, a level above the flume, a std_msgs/String on the inflow
 topic). It subscribes to `<ns>/bed_profile`, `<ns>/eroded_mass`, `<ns>/gauges/predicted`,
-`/clock` and `/diagnostics`, and prints each message it receives as one JSON line, with what it
+`<ns>/particles`, `<ns>/bed_marker`, `/clock` and `/diagnostics`, and prints each message it receives as one JSON line, with what it
 sent first (`{"sent": ...}` lines), until SECONDS have passed or the twin's last output came.
 
 Usage: python3 tests/interop/dds_peer.py NAMESPACE DURATION_S SECONDS
@@ -14,6 +14,7 @@ Usage: python3 tests/interop/dds_peer.py NAMESPACE DURATION_S SECONDS
 
 import json
 import math
+import struct
 import os
 import sys
 import tempfile
@@ -138,6 +139,116 @@ class String(IdlStruct, typename="std_msgs::msg::dds_::String_"):
     data: str
 
 
+@dataclass
+class PointField(IdlStruct, typename="sensor_msgs::msg::dds_::PointField_"):
+    name: str
+    offset: uint32
+    datatype: uint8
+    count: uint32
+
+
+@dataclass
+class PointCloud2(IdlStruct, typename="sensor_msgs::msg::dds_::PointCloud2_"):
+    header: Header
+    height: uint32
+    width: uint32
+    fields: sequence[PointField]
+    is_bigendian: bool
+    point_step: uint32
+    row_step: uint32
+    data: sequence[uint8]
+    is_dense: bool
+
+
+@dataclass
+class Duration(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
+    sec: int32
+    nanosec: uint32
+
+
+@dataclass
+class Point(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
+    x: float64
+    y: float64
+    z: float64
+
+
+@dataclass
+class Quaternion(IdlStruct, typename="geometry_msgs::msg::dds_::Quaternion_"):
+    x: float64
+    y: float64
+    z: float64
+    w: float64
+
+
+@dataclass
+class Pose(IdlStruct, typename="geometry_msgs::msg::dds_::Pose_"):
+    position: Point
+    orientation: Quaternion
+
+
+@dataclass
+class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
+    x: float64
+    y: float64
+    z: float64
+
+
+@dataclass
+class ColorRGBA(IdlStruct, typename="std_msgs::msg::dds_::ColorRGBA_"):
+    r: float32
+    g: float32
+    b: float32
+    a: float32
+
+
+@dataclass
+class CompressedImage(IdlStruct, typename="sensor_msgs::msg::dds_::CompressedImage_"):
+    header: Header
+    format: str
+    data: sequence[uint8]
+
+
+@dataclass
+class UVCoordinate(IdlStruct, typename="visualization_msgs::msg::dds_::UVCoordinate_"):
+    u: float32
+    v: float32
+
+
+@dataclass
+class MeshFile(IdlStruct, typename="visualization_msgs::msg::dds_::MeshFile_"):
+    filename: str
+    data: sequence[uint8]
+
+
+@dataclass
+class Marker(IdlStruct, typename="visualization_msgs::msg::dds_::Marker_"):
+    header: Header
+    ns: str
+    id: int32
+    type: int32
+    action: int32
+    pose: Pose
+    scale: Vector3
+    color: ColorRGBA
+    lifetime: Duration
+    frame_locked: bool
+    points: sequence[Point]
+    colors: sequence[ColorRGBA]
+    texture_resource: str
+    texture: CompressedImage
+    uv_coordinates: sequence[UVCoordinate]
+    text: str
+    mesh_resource: str
+    mesh_file: MeshFile
+    mesh_use_embedded_materials: bool
+
+
+@dataclass
+class MarkerArray(IdlStruct, typename="visualization_msgs::msg::dds_::MarkerArray_"):
+    markers: sequence[Marker]
+
+
 def stamp(t: float) -> Header:
     sec = math.floor(t)
     return Header(Time(sec, int(round((t - sec) * 1e9)) % 1_000_000_000), "lab")
@@ -175,6 +286,8 @@ def main() -> None:
         "predicted": DataReader(dp, Topic(dp, f"rt{ns}/gauges/predicted", GaugeComparison), reliable),
         "clock": DataReader(dp, Topic(dp, "rt/clock", Clock), best_effort),
         "diagnostics": DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), reliable),
+        "particles": DataReader(dp, Topic(dp, f"rt{ns}/particles", PointCloud2), best_effort),
+        "bed_marker": DataReader(dp, Topic(dp, f"rt{ns}/bed_marker", MarkerArray), latched),
     }
     # Discovery first: samples sent before the twin's readers match would be lost.
     deadline = time.time() + 20.0
@@ -221,6 +334,19 @@ def main() -> None:
                         {"name": g.name, "predicted": fix(g.predicted_m),
                          "measured": fix(g.measured_m), "residual": fix(g.residual_m),
                          "stale": g.stale} for g in s.gauges]}
+                elif kind == "particles":
+                    data = bytes(s.data)
+                    points = [struct.unpack_from("<ffffB", data, k * s.point_step)
+                              for k in range(s.width)]
+                    body = {"t": secs(s.header), "width": s.width, "point_step": s.point_step,
+                            "fields": [[f.name, f.offset, f.datatype] for f in s.fields],
+                            "finite": all(math.isfinite(v) for p in points for v in p[:4]),
+                            "phases": sorted({p[4] for p in points}),
+                            "max_speed": max((p[3] for p in points), default=0.0)}
+                elif kind == "bed_marker":
+                    body = {"t": secs(s.markers[0].header) if s.markers else None,
+                            "markers": [{"ns": m.ns, "type": m.type, "points": len(m.points)}
+                                        for m in s.markers]}
                 elif kind == "clock":
                     body = {"t": s.clock.sec + s.clock.nanosec * 1e-9}
                 else:
