@@ -582,6 +582,48 @@ fn comparison(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use clap::Parser;
+
+    fn run_args(extra: &[&str]) -> RunArgs {
+        let mut argv = vec!["flume-twin", "run", "case.yaml"];
+        argv.extend_from_slice(extra);
+        match crate::cli::Cli::parse_from(argv).command {
+            crate::cli::Command::Run(a) => a,
+            _ => unreachable!("parsed a run"),
+        }
+    }
+
+    #[test]
+    fn the_shipped_parameter_file_sets_the_node_and_bad_values_are_refused() {
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../launch_configs/flume_twin.params.yaml"
+        );
+        let ros =
+            RosArgs::parse(&["--params-file", file, "-p", "publish_rate_hz:=4"]).expect("parses");
+        let s = Settings::new(
+            &run_args(&[]),
+            &ros.parameters("/flume/flume_twin").expect("reads"),
+        )
+        .expect("valid");
+        assert_eq!(s.target_rtf, 1.0);
+        assert_eq!(s.publish_rate_hz, 4.0, "-p wins over the file");
+        assert_eq!(s.stale_after_s, 2.0);
+        assert_eq!(s.frame_id, "flume");
+        for (bad, reason) in [
+            ("target_real_time_factor:=-1", "must be a positive number"),
+            ("publish_rate_hz:=fast", "must be a positive number"),
+            ("frame_id:=3", "must be a string"),
+        ] {
+            let ros = RosArgs::parse(&["-p", bad]).expect("parses");
+            let err = Settings::new(
+                &run_args(&[]),
+                &ros.parameters("/flume_twin").expect("reads"),
+            )
+            .expect_err("refused");
+            assert!(err.to_string().contains(reason), "{bad}: {err}");
+        }
+    }
 
     #[test]
     fn a_gauge_is_compared_with_its_reading_at_the_output_time() {

@@ -387,3 +387,30 @@ fn a_flume_run_writes_bed_profile_eroded_mass_and_the_bed_plot() {
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     assert!(stdout.contains("bed plot: "), "{stdout}");
 }
+
+/// The launch file is well-formed XML that starts `flume-twin run` with the shipped parameter
+/// file, and the rviz config is YAML that shows the twin's particle and bed-line topics.
+#[test]
+fn the_launch_file_and_rviz_config_are_well_formed() {
+    let launch = repo_file("launch_configs/flume_twin.launch.xml");
+    let out = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); \
+             print(r.tag, r.find('executable').get('cmd'))",
+            launch.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let printed = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(printed.starts_with("launch flume-twin run "), "{printed}");
+    assert!(printed.contains("--params-file $(var params)"), "{printed}");
+    let rviz = fs::read_to_string(repo_file("launch_configs/flume_twin.rviz")).unwrap();
+    assert!(rviz.contains("Value: /flume/particles") && rviz.contains("Value: /flume/bed_marker"));
+    let yaml: serde_norway::Value = serde_norway::from_str(&rviz).unwrap();
+    assert_eq!(
+        yaml["Visualization Manager"]["Global Options"]["Fixed Frame"],
+        serde_norway::Value::from("flume")
+    );
+}
