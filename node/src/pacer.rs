@@ -46,6 +46,13 @@ impl Pacer {
         }
     }
 
+    /// A new target factor: the free-running clock restarts from where the twin is, so the
+    /// change does not rescale the time already run.
+    pub fn set_target_rtf(&mut self, rtf: f64) {
+        self.target_rtf = rtf;
+        self.anchor = None;
+    }
+
     /// Node-clock time of simulated time 0, once fixed.
     pub fn origin(&self) -> Option<f64> {
         self.origin
@@ -182,6 +189,17 @@ mod tests {
         assert_eq!(p.origin(), Some(61.0), "t = 0 is the first sample");
         let c = p.next_chunk(0.0, 61.5, 1.0).expect("runs");
         assert!((c.to_s - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_new_target_factor_applies_from_now_on() {
+        let mut p = Pacer::new(1.0, 1.0, false);
+        assert!((p.target(0.0, 10.0) - 0.0).abs() < 1e-9);
+        assert!((p.target(0.0, 12.0) - 2.0).abs() < 1e-9);
+        // Reached 2 s at 12 s; at factor 0.25 the next 4 s of wall time are 1 s simulated.
+        p.set_target_rtf(0.25);
+        assert!((p.target(2.0, 12.0) - 2.0).abs() < 1e-9);
+        assert!((p.target(2.0, 16.0) - 3.0).abs() < 1e-9);
     }
 
     #[test]

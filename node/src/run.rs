@@ -27,12 +27,13 @@ use futures::StreamExt;
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{
-    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher, QosProfile,
-    Subscription,
+    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher,
+    QosProfile, Subscription,
 };
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use std::net::Ipv4Addr;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 /// The node's clock: ROS time, seconds since the epoch.
@@ -110,28 +111,108 @@ impl Settings {
             frame_id: "flume".into(),
         };
         for (name, value) in params {
-            let number = || {
-                value
-                    .as_f64()
-                    .filter(|v| v.is_finite() && *v > 0.0)
-                    .ok_or_else(|| {
-                        anyhow!("parameter {name}: must be a positive number, got {value:?}")
-                    })
-            };
-            match name.as_str() {
-                "target_real_time_factor" => s.target_rtf = number()?,
-                "publish_rate_hz" => s.publish_rate_hz = number()?,
-                "stale_after_s" => s.stale_after_s = number()?,
-                "frame_id" => match value {
-                    ParamValue::String(f) => s.frame_id = f.clone(),
-                    other => bail!("parameter frame_id: must be a string, got {other:?}"),
-                },
-                "use_sim_time" => {}
-                other => log::warn!("parameter {other} is not one of flume_twin's; ignored"),
+            if !PARAMETERS.contains(&name.as_str()) {
+                log::warn!("parameter {name} is not one of flume_twin's; ignored");
+                continue;
             }
+            s.apply(name, value)
+                .map_err(|reason| anyhow!("parameter {name}: {reason}"))?;
         }
         Ok(s)
     }
+
+    /// Sets parameter `name`, or says why not.
+    fn apply(&mut self, name: &str, value: &ParamValue) -> Result<(), String> {
+        let number = || {
+            value
+                .as_f64()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| format!("must be a positive number, got {value:?}"))
+        };
+        match name {
+            "target_real_time_factor" => self.target_rtf = number()?,
+            "publish_rate_hz" => self.publish_rate_hz = number()?,
+            "stale_after_s" => self.stale_after_s = number()?,
+            "frame_id" => match value {
+                ParamValue::String(f) if !f.is_empty() => self.frame_id = f.clone(),
+                other => return Err(format!("must be a non-empty string, got {other:?}")),
+            },
+            "use_sim_time" => {
+                if !matches!(value, ParamValue::Bool(_)) {
+                    return Err(format!("must be true or false, got {value:?}"));
+                }
+            }
+            other => return Err(format!("{other} is not a parameter of flume_twin")),
+        }
+        Ok(())
+    }
+
+    /// The values to declare to ROS, as `ros2 param` shows them.
+    fn declared(&self) -> Vec<(&'static str, ParameterValue)> {
+        vec![
+            (
+                "target_real_time_factor",
+                ParameterValue::Double(self.target_rtf),
+            ),
+            (
+                "publish_rate_hz",
+                ParameterValue::Double(self.publish_rate_hz),
+            ),
+            ("stale_after_s", ParameterValue::Double(self.stale_after_s)),
+            ("frame_id", ParameterValue::String(self.frame_id.clone())),
+        ]
+    }
+}
+
+/// The node's parameters (use_sim_time is ROS's own, declared by every node).
+const PARAMETERS: [&str; 5] = [
+    "target_real_time_factor",
+    "publish_rate_hz",
+    "stale_after_s",
+    "frame_id",
+    "use_sim_time",
+];
+
+/// A parameter value from ROS as ours; arrays are none of our parameters.
+fn from_ros(value: &ParameterValue) -> Option<ParamValue> {
+    match value {
+        ParameterValue::Boolean(b) => Some(ParamValue::Bool(*b)),
+        ParameterValue::Integer(i) => Some(ParamValue::Integer(*i)),
+        ParameterValue::Double(d) => Some(ParamValue::Double(*d)),
+        ParameterValue::String(t) => Some(ParamValue::String(t.clone())),
+        _ => None,
+    }
+}
+
+/// `ros2 param set` on a running node: the validator refuses with the reason, the action
+/// applies to the settings the loop reads.
+fn live_parameters(options: NodeOptions, live: &Arc<Mutex<Settings>>) -> NodeOptions {
+    let check = Arc::clone(live);
+    let set = Arc::clone(live);
+    let lock = |m: &Arc<Mutex<Settings>>| -> Settings {
+        m.lock().unwrap_or_else(|p| p.into_inner()).clone()
+    };
+    let initial = lock(live);
+    let mut options = options;
+    for (name, value) in initial.declared() {
+        options = options.declare_parameter(name, value);
+    }
+    options
+        .parameter_validator(Box::new(move |name, value| {
+            let value =
+                from_ros(value).ok_or_else(|| format!("{name}: arrays are not accepted"))?;
+            lock(&check)
+                .apply(name, &value)
+                .map_err(|r| format!("{name}: {r}"))
+        }))
+        .parameter_set_action(Box::new(move |name, value| {
+            let value =
+                from_ros(value).ok_or_else(|| format!("{name}: arrays are not accepted"))?;
+            let mut s = set.lock().unwrap_or_else(|p| p.into_inner());
+            s.apply(name, &value).map_err(|r| format!("{name}: {r}"))?;
+            log::info!("parameter {name} set to {value:?}");
+            Ok(())
+        }))
 }
 
 /// A gauge's accepted readings, oldest first, from the one in force at the last output on.
@@ -216,6 +297,8 @@ async fn serve(
     } = solver_thread::spawn(case, args.out.clone())?;
     println!("adapter: {adapter}\nparticles: {particles}\nnode: {namespace} {node_name}");
 
+    let live = Arc::new(Mutex::new(settings.clone()));
+    let mut settings = settings;
     let context = if args.loopback {
         let participant = DomainParticipantBuilder::new(args.domain_id)
             .with_only_networks([Ipv4Addr::LOCALHOST])
@@ -230,7 +313,7 @@ async fn serve(
         .new_node(
             NodeName::new(&namespace, &node_name)
                 .map_err(|e| anyhow!("node name {namespace} {node_name}: {e}"))?,
-            NodeOptions::new().enable_rosout(true),
+            live_parameters(NodeOptions::new().enable_rosout(true), &live),
         )
         .context("cannot create the ROS 2 node")?;
     let spinner = node.spinner().context("cannot spin the node")?;
@@ -392,6 +475,12 @@ async fn serve(
                 }
             }
             _ = tick.tick() => {
+                let now_live = live.lock().unwrap_or_else(|p| p.into_inner()).clone();
+                if now_live.target_rtf != pacer.target_rtf {
+                    pacer.set_target_rtf(now_live.target_rtf);
+                }
+                pacer.stale_after_s = now_live.stale_after_s;
+                settings = now_live;
                 if !in_flight {
                     let now = now_s();
                     let mut cap = args.max_chunk_s;
@@ -613,7 +702,7 @@ mod tests {
         for (bad, reason) in [
             ("target_real_time_factor:=-1", "must be a positive number"),
             ("publish_rate_hz:=fast", "must be a positive number"),
-            ("frame_id:=3", "must be a string"),
+            ("frame_id:=3", "must be a non-empty string"),
         ] {
             let ros = RosArgs::parse(&["-p", bad]).expect("parses");
             let err = Settings::new(

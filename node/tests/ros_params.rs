@@ -1,0 +1,192 @@
+//! Parameters set from outside while the twin runs, through the standard `rcl_interfaces`
+//! services `ros2 param` uses (here called with ros2-client from another process): a bad
+//! value is refused with its reason and changes nothing; a good one takes effect, as the
+//! node's own /diagnostics then reports.
+
+use flume_msgs::diagnostic_msgs::DiagnosticArray;
+use flume_msgs::RosMessage;
+use futures::StreamExt;
+use ros2_client::dds::rustdds::DomainParticipantBuilder;
+use ros2_client::qos::History;
+use ros2_client::rcl_interfaces::{
+    GetParametersRequest, GetParametersResponse, SetParametersRequest, SetParametersResponse,
+};
+use ros2_client::{
+    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, Parameter, ParameterValue,
+    QosProfile, ServiceMapping, ServiceTypeName,
+};
+use std::net::Ipv4Addr;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+fn repo_file(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+}
+
+/// Kills the twin however the test ends.
+struct Twin(Child);
+
+impl Drop for Twin {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn set(name: &str, value: ParameterValue) -> SetParametersRequest {
+    SetParametersRequest {
+        parameter: vec![
+            Parameter {
+                name: name.into(),
+                value,
+            }
+            .into(),
+        ],
+    }
+}
+
+async fn call<Req, Resp>(
+    node: &Node,
+    client: &ros2_client::service::Client<Req, Resp>,
+    request: Req,
+) -> Resp
+where
+    Req: ros2_client::Message + 'static,
+    Resp: ros2_client::Message + 'static,
+{
+    tokio::time::timeout(Duration::from_secs(30), client.wait_for_service(node))
+        .await
+        .expect("the twin's parameter service appears");
+    let id = client.async_send_request(request).await.expect("sent");
+    tokio::time::timeout(Duration::from_secs(10), client.async_receive_response(id))
+        .await
+        .expect("answered in time")
+        .expect("an answer")
+}
+
+#[test]
+fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reason() {
+    if flume_solver::GpuContext::new().is_err() {
+        assert!(std::env::var("CI").as_deref() != Ok("true"), "CI=true and no GPU adapter");
+        eprintln!("note: skipping a GPU test, no adapter");
+        return;
+    }
+    let _twin = Twin(
+        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .args([
+                "run",
+                repo_file("solver/tests/cases/recycle_2d.yaml").to_str().expect("utf-8"),
+                "--loopback",
+                "--wait-for-sensors",
+                "--ros-args",
+                "-r",
+                "__ns:=/flume_params",
+                "-p",
+                "target_real_time_factor:=0.5",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the twin starts"),
+    );
+    let runtime = tokio::runtime::Runtime::new().expect("runtime");
+    runtime.block_on(async {
+        let participant = DomainParticipantBuilder::new(0)
+            .with_only_networks([Ipv4Addr::LOCALHOST])
+            .build()
+            .expect("DDS");
+        let context = Context::from_domain_participant(participant).expect("context");
+        let mut node = context
+            .new_node(
+                NodeName::new("/flume_params", "param_client").expect("name"),
+                NodeOptions::new(),
+            )
+            .expect("node");
+        tokio::spawn(node.spinner().expect("spinner").spin());
+        let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 1 });
+        let target = "/flume_params/flume_twin";
+        let setter = node
+            .create_client::<SetParametersRequest, SetParametersResponse>(
+                ServiceMapping::Enhanced,
+                &Name::new(target, "set_parameters").expect("name"),
+                &ServiceTypeName::new("rcl_interfaces", "SetParameters"),
+                qos.clone(),
+                qos.clone(),
+            )
+            .expect("client");
+        let getter = node
+            .create_client::<GetParametersRequest, GetParametersResponse>(
+                ServiceMapping::Enhanced,
+                &Name::new(target, "get_parameters").expect("name"),
+                &ServiceTypeName::new("rcl_interfaces", "GetParameters"),
+                qos.clone(),
+                qos,
+            )
+            .expect("client");
+        let diag_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+        let diag_topic = node
+            .create_topic(
+                &Name::new("/", "diagnostics").expect("name"),
+                MessageTypeName::new(DiagnosticArray::DEF.package, DiagnosticArray::DEF.name),
+                &diag_qos,
+            )
+            .expect("topic");
+        let diagnostics = node
+            .create_subscription::<DiagnosticArray>(&diag_topic, Some(diag_qos))
+            .expect("subscription");
+
+        let refused = call(
+            &node,
+            &setter,
+            set("target_real_time_factor", ParameterValue::Double(-1.0)),
+        )
+        .await;
+        let r = &refused.results[0];
+        eprintln!("set target_real_time_factor -1: {} {:?}", r.successful, r.reason);
+        assert!(!r.successful);
+        assert!(r.reason.contains("must be a positive number"), "{}", r.reason);
+        let refused = call(&node, &setter, set("frame_id", ParameterValue::Integer(3))).await;
+        assert!(!refused.results[0].successful);
+
+        let accepted = call(
+            &node,
+            &setter,
+            set("target_real_time_factor", ParameterValue::Double(0.02)),
+        )
+        .await;
+        assert!(accepted.results[0].successful, "{:?}", accepted.results[0].reason);
+        let got = call(
+            &node,
+            &getter,
+            GetParametersRequest {
+                names: vec!["target_real_time_factor".into(), "frame_id".into()],
+            },
+        )
+        .await;
+        let values: Vec<ParameterValue> = got.values.into_iter().map(Into::into).collect();
+        assert_eq!(
+            values,
+            vec![
+                ParameterValue::Double(0.02),
+                ParameterValue::String("flume".into())
+            ]
+        );
+
+        // The twin's own report: the pacer now runs at the new factor.
+        let mut stream = Box::pin(diagnostics.async_stream());
+        let seen = tokio::time::timeout(Duration::from_secs(20), async {
+            while let Some(Ok((msg, _))) = stream.next().await {
+                let reported = msg.status.iter().flat_map(|s| &s.values).find_map(|kv| {
+                    (kv.key == "target_real_time_factor").then(|| kv.value.clone())
+                });
+                if reported.as_deref() == Some("0.02") {
+                    return true;
+                }
+            }
+            false
+        })
+        .await;
+        assert_eq!(seen, Ok(true), "/diagnostics never reported the new factor");
+    });
+}
