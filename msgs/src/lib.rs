@@ -16,6 +16,7 @@ pub mod geometry_msgs;
 pub mod rosgraph_msgs;
 pub mod sensor_msgs;
 pub mod std_msgs;
+pub mod std_srvs;
 pub mod visualization_msgs;
 
 pub use definition::{MsgDef, RosMessage};

@@ -103,6 +103,23 @@ impl Pacer {
         self.target(sim_t, now) - sim_t
     }
 
+    /// One chunk of `len_s` from `sim_t` whatever the sensors say (a paused twin's single
+    /// step), with the inputs stamped in it.
+    pub fn step(&mut self, sim_t: f64, len_s: f64) -> Chunk {
+        let to_s = sim_t + len_s;
+        let mut inflow = Vec::new();
+        while let Some(&(t, q)) = self.pending.front() {
+            if t > to_s {
+                break;
+            }
+            inflow.push((t.max(sim_t), q));
+            self.pending.pop_front();
+        }
+        // The free-running clock, if it runs, restarts from the step's end.
+        self.anchor = None;
+        Chunk { to_s, inflow }
+    }
+
     /// The next chunk from `sim_t`, at most `max_chunk_s` long; None when the twin is where
     /// it should be.
     pub fn next_chunk(&mut self, sim_t: f64, now: f64, max_chunk_s: f64) -> Option<Chunk> {

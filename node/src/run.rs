@@ -20,6 +20,7 @@ use flume_msgs::flume_msgs::{
 use flume_msgs::rosgraph_msgs::Clock;
 use flume_msgs::sensor_msgs::PointCloud2;
 use flume_msgs::std_msgs::Header;
+use flume_msgs::std_srvs::{TriggerRequest, TriggerResponse};
 use flume_msgs::visualization_msgs::MarkerArray;
 use flume_msgs::{MsgDef, RosMessage};
 use flume_solver::{Case, Observations};
@@ -28,7 +29,7 @@ use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{
     Context, MessageTypeName, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher,
-    QosProfile, Subscription,
+    QosProfile, ServiceMapping, ServiceTypeName, Subscription,
 };
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -364,6 +365,36 @@ async fn serve(
         reliable(1).durability(Durability::TransientLocal),
     )?;
     let mut last_cloud: Option<Instant> = None;
+    let node_path = format!("{}/{node_name}", namespace.trim_end_matches('/'));
+    let servers = [
+        Service::Reset,
+        Service::Pause,
+        Service::Resume,
+        Service::Step,
+    ]
+    .iter()
+    .map(|s| {
+        let qos = reliable(10);
+        node.create_server::<TriggerRequest, TriggerResponse>(
+            ServiceMapping::Enhanced,
+            &Name::new(&node_path, s.name()).map_err(|e| anyhow!("service {}: {e}", s.name()))?,
+            &ServiceTypeName::new("std_srvs", "Trigger"),
+            qos.clone(),
+            qos,
+        )
+        .with_context(|| format!("cannot offer the {} service", s.name()))
+    })
+    .collect::<Result<Vec<_>>>()?;
+    let mut service_requests =
+        futures::stream::select_all(servers.iter().enumerate().map(|(k, srv)| {
+            let which = [
+                Service::Reset,
+                Service::Pause,
+                Service::Resume,
+                Service::Step,
+            ][k];
+            Box::pin(srv.receive_request_stream().map(move |r| (which, r)))
+        }));
 
     let mut inflow_stream = Box::pin(inflow_sub.async_stream());
     let mut gauge_stream = futures::stream::select_all(
@@ -380,7 +411,9 @@ async fn serve(
     );
     let mut measured: Vec<Readings> = vec![Readings::default(); gauge_names.len()];
     let mut sim_t = 0.0;
-    let mut in_flight = false;
+    // Commands sent to the solver and not yet reported.
+    let mut outstanding = 0u32;
+    let mut paused = false;
     let mut undecodable = 0u64;
     let mut solver_refused = 0u64;
     let mut published_outputs = 0u64;
@@ -425,9 +458,15 @@ async fn serve(
                 }
             },
             Some(report) = reports.recv() => {
-                in_flight = false;
+                outstanding = outstanding.saturating_sub(1);
                 let report: Report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
                 sim_t = report.obs.time_s;
+                if report.reset {
+                    // A new start: t = 0 is the next event; queued inputs belonged to the old run.
+                    pacer = Pacer::new(pacer.target_rtf, pacer.stale_after_s, args.wait_for_sensors);
+                    measured = vec![Readings::default(); gauge_names.len()];
+                    println!("reset to the case's initial state");
+                }
                 solver_refused += report.refused_inflows;
                 period.add(&report);
                 let origin = pacer.origin().unwrap_or_else(now_s);
@@ -481,7 +520,7 @@ async fn serve(
                 }
                 pacer.stale_after_s = now_live.stale_after_s;
                 settings = now_live;
-                if !in_flight {
+                if outstanding == 0 && !paused {
                     let now = now_s();
                     let mut cap = args.max_chunk_s;
                     if let Some(u) = until {
@@ -496,8 +535,47 @@ async fn serve(
                         commands
                             .send(Command::Advance { to_s: chunk.to_s, inflow: chunk.inflow, cloud })
                             .map_err(|_| anyhow!("the solver thread has stopped"))?;
-                        in_flight = true;
+                        outstanding += 1;
                     }
+                }
+            }
+            Some((which, request)) = service_requests.next() => {
+                let Ok((id, _)) = request else {
+                    log::warn!("a {which:?} request could not be read");
+                    continue;
+                };
+                let (success, message) = match which {
+                    Service::Pause => {
+                        paused = true;
+                        (true, format!("paused at t = {sim_t:.3} s; inputs are still taken"))
+                    }
+                    Service::Resume => {
+                        paused = false;
+                        pacer.set_target_rtf(pacer.target_rtf);
+                        (true, format!("resumed at t = {sim_t:.3} s"))
+                    }
+                    Service::Step if !paused => (false, "pause the twin first".to_string()),
+                    Service::Step => {
+                        let chunk = pacer.step(sim_t, args.max_chunk_s);
+                        let to = chunk.to_s;
+                        commands
+                            .send(Command::Advance { to_s: to, inflow: chunk.inflow, cloud: true })
+                            .map_err(|_| anyhow!("the solver thread has stopped"))?;
+                        outstanding += 1;
+                        (true, format!("stepping from t = {sim_t:.3} s to {to:.3} s"))
+                    }
+                    Service::Reset => {
+                        commands
+                            .send(Command::Reset)
+                            .map_err(|_| anyhow!("the solver thread has stopped"))?;
+                        outstanding += 1;
+                        (true, "resetting to the case's initial state".to_string())
+                    }
+                };
+                println!("service {which:?}: {message}");
+                let server = &servers[which as usize];
+                if let Err(e) = server.async_send_response(id, TriggerResponse { success, message }).await {
+                    log::warn!("the {which:?} response could not be sent: {e:?}");
                 }
             }
             _ = diag_tick.tick() => {
@@ -520,6 +598,7 @@ async fn serve(
                     ("adapter", adapter.clone()),
                     ("solver_busy_fraction", format!("{busy:.3}")),
                     ("sensor_driven", pacer.sensor_driven(now).to_string()),
+                    ("paused", paused.to_string()),
                     ("stale_sensors", stale.join(",")),
                     ("rejected_inputs", gate.refused_total().to_string()),
                     ("undecodable_inputs", undecodable.to_string()),
@@ -571,6 +650,27 @@ async fn serve(
 async fn publish<M: Serialize + std::fmt::Debug>(publisher: &Publisher<M>, msg: M) {
     if let Err(e) = publisher.async_publish(msg).await {
         log::warn!("a message could not be published: {e:?}");
+    }
+}
+
+/// The twin's services (std_srvs/Trigger), under the node's name; the order is that of the
+/// servers.
+#[derive(Debug, Clone, Copy)]
+enum Service {
+    Reset = 0,
+    Pause = 1,
+    Resume = 2,
+    Step = 3,
+}
+
+impl Service {
+    fn name(self) -> &'static str {
+        match self {
+            Service::Reset => "reset",
+            Service::Pause => "pause",
+            Service::Resume => "resume",
+            Service::Step => "step",
+        }
     }
 }
 

@@ -20,6 +20,8 @@ pub enum Command {
         inflow: Vec<(f64, f64)>,
         cloud: bool,
     },
+    /// Back to the case's initial state.
+    Reset,
 }
 
 /// What a chunk did.
@@ -34,6 +36,8 @@ pub struct Report {
     pub refused_inflows: u64,
     /// The particles in the flow (not the parked ones), when asked for.
     pub cloud: Option<Vec<CloudPoint>>,
+    /// This report is the initial state after a reset.
+    pub reset: bool,
 }
 
 /// The solver thread's end of the channels, and what it says when it starts.
@@ -56,16 +60,17 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
     let handle = std::thread::Builder::new()
         .name("flume-solver".into())
         .spawn(move || {
-            let started = (|| -> Result<(Simulation, Option<Recorder>)> {
+            let started = (|| -> Result<(Arc<GpuContext>, Simulation, Option<Recorder>)> {
                 let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
-                let sim = Simulation::new(gpu, &case).context("cannot set up the simulation")?;
+                let sim = Simulation::new(Arc::clone(&gpu), &case)
+                    .context("cannot set up the simulation")?;
                 let recorder = match &out {
                     Some(dir) => Some(Recorder::create(dir, &case, None)?),
                     None => None,
                 };
-                Ok((sim, recorder))
+                Ok((gpu, sim, recorder))
             })();
-            let (mut sim, mut recorder) = match started {
+            let (gpu, mut sim, mut recorder) = match started {
                 Ok(s) => s,
                 Err(e) => {
                     let _ = ready_tx.send(Err(format!("{e:#}")));
@@ -88,15 +93,14 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                 .open_flume
                 .as_ref()
                 .map(|_| flume_solver::case::parked_phase(&case));
-            while let Ok(Command::Advance {
-                to_s,
-                inflow,
-                cloud,
-            }) = cmd_rx.recv()
-            {
+            while let Ok(command) = cmd_rx.recv() {
                 k += 1;
-                let report =
-                    run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
+                let report = match command {
+                    Command::Advance {
+                        to_s,
+                        inflow,
+                        cloud,
+                    } => run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
                         let cloud = if cloud {
                             Some(cloud_points(&sim, parked)?)
                         } else {
@@ -108,8 +112,26 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                             steps,
                             refused_inflows: refused,
                             cloud,
+                            reset: false,
                         })
-                    });
+                    }),
+                    Command::Reset => {
+                        let started = Instant::now();
+                        Simulation::new(Arc::clone(&gpu), &case)
+                            .map_err(|e| format!("cannot rebuild the case: {e}"))
+                            .and_then(|fresh| {
+                                sim = fresh;
+                                observe(&sim, recorder.as_mut(), k).map(|obs| Report {
+                                    obs,
+                                    wall_s: started.elapsed().as_secs_f64(),
+                                    steps: 0,
+                                    refused_inflows: 0,
+                                    cloud: None,
+                                    reset: true,
+                                })
+                            })
+                    }
+                };
                 let failed = report.is_err();
                 if rep_tx.send(report).is_err() || failed {
                     return;

@@ -1,10 +1,11 @@
-//! Parameters set from outside while the twin runs, through the standard `rcl_interfaces`
-//! services `ros2 param` uses (here called with ros2-client from another process): a bad
-//! value is refused with its reason and changes nothing; a good one takes effect, as the
-//! node's own /diagnostics then reports.
+//! The twin controlled from another process (here with ros2-client): parameters through the
+//! standard `rcl_interfaces` services `ros2 param` uses (a bad value refused with its reason,
+//! a good one taking effect, as the node's own /diagnostics then reports), and the pause,
+//! step, resume and reset services (std_srvs/Trigger).
 
-use flume_msgs::diagnostic_msgs::DiagnosticArray;
 use flume_msgs::RosMessage;
+use flume_msgs::diagnostic_msgs::DiagnosticArray;
+use flume_msgs::std_srvs::{TriggerRequest, TriggerResponse};
 use futures::StreamExt;
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::qos::History;
@@ -21,7 +22,9 @@ use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 fn repo_file(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(rel)
 }
 
 /// Kills the twin however the test ends.
@@ -65,10 +68,53 @@ where
         .expect("an answer")
 }
 
+fn trigger(
+    node: &mut Node,
+    target: &str,
+    name: &str,
+) -> ros2_client::service::Client<TriggerRequest, TriggerResponse> {
+    let qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+    node.create_client::<TriggerRequest, TriggerResponse>(
+        ServiceMapping::Enhanced,
+        &Name::new(target, name).expect("name"),
+        &ServiceTypeName::new("std_srvs", "Trigger"),
+        qos.clone(),
+        qos,
+    )
+    .expect("client")
+}
+
+/// The value of `key` in the next /diagnostics for which `accept` holds, within 20 s.
+async fn diagnostic<S>(stream: &mut S, key: &str, accept: impl Fn(&str) -> bool) -> Option<String>
+where
+    S: futures::Stream<Item = ros2_client::ReadResult<(DiagnosticArray, ros2_client::MessageInfo)>>
+        + Unpin,
+{
+    tokio::time::timeout(Duration::from_secs(20), async {
+        while let Some(Ok((msg, _))) = stream.next().await {
+            let value = msg
+                .status
+                .iter()
+                .flat_map(|s| &s.values)
+                .find_map(|kv| (kv.key == key).then(|| kv.value.clone()));
+            if let Some(v) = value.filter(|v| accept(v)) {
+                return Some(v);
+            }
+        }
+        None
+    })
+    .await
+    .ok()
+    .flatten()
+}
+
 #[test]
-fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reason() {
+fn parameters_and_services_from_another_process_control_the_twin() {
     if flume_solver::GpuContext::new().is_err() {
-        assert!(std::env::var("CI").as_deref() != Ok("true"), "CI=true and no GPU adapter");
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "CI=true and no GPU adapter"
+        );
         eprintln!("note: skipping a GPU test, no adapter");
         return;
     }
@@ -76,7 +122,9 @@ fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reaso
         Command::new(env!("CARGO_BIN_EXE_flume-twin"))
             .args([
                 "run",
-                repo_file("solver/tests/cases/recycle_2d.yaml").to_str().expect("utf-8"),
+                repo_file("solver/tests/cases/recycle_2d.yaml")
+                    .to_str()
+                    .expect("utf-8"),
                 "--loopback",
                 "--wait-for-sensors",
                 "--ros-args",
@@ -124,6 +172,12 @@ fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reaso
                 qos,
             )
             .expect("client");
+        let (pause, step, resume, reset) = (
+            trigger(&mut node, target, "pause"),
+            trigger(&mut node, target, "step"),
+            trigger(&mut node, target, "resume"),
+            trigger(&mut node, target, "reset"),
+        );
         let diag_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
         let diag_topic = node
             .create_topic(
@@ -143,9 +197,16 @@ fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reaso
         )
         .await;
         let r = &refused.results[0];
-        eprintln!("set target_real_time_factor -1: {} {:?}", r.successful, r.reason);
+        eprintln!(
+            "set target_real_time_factor -1: {} {:?}",
+            r.successful, r.reason
+        );
         assert!(!r.successful);
-        assert!(r.reason.contains("must be a positive number"), "{}", r.reason);
+        assert!(
+            r.reason.contains("must be a positive number"),
+            "{}",
+            r.reason
+        );
         let refused = call(&node, &setter, set("frame_id", ParameterValue::Integer(3))).await;
         assert!(!refused.results[0].successful);
 
@@ -155,7 +216,11 @@ fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reaso
             set("target_real_time_factor", ParameterValue::Double(0.02)),
         )
         .await;
-        assert!(accepted.results[0].successful, "{:?}", accepted.results[0].reason);
+        assert!(
+            accepted.results[0].successful,
+            "{:?}",
+            accepted.results[0].reason
+        );
         let got = call(
             &node,
             &getter,
@@ -175,18 +240,43 @@ fn parameters_set_from_outside_take_effect_and_bad_ones_are_refused_with_a_reaso
 
         // The twin's own report: the pacer now runs at the new factor.
         let mut stream = Box::pin(diagnostics.async_stream());
-        let seen = tokio::time::timeout(Duration::from_secs(20), async {
-            while let Some(Ok((msg, _))) = stream.next().await {
-                let reported = msg.status.iter().flat_map(|s| &s.values).find_map(|kv| {
-                    (kv.key == "target_real_time_factor").then(|| kv.value.clone())
-                });
-                if reported.as_deref() == Some("0.02") {
-                    return true;
-                }
-            }
-            false
-        })
-        .await;
-        assert_eq!(seen, Ok(true), "/diagnostics never reported the new factor");
+        assert_eq!(
+            diagnostic(&mut stream, "target_real_time_factor", |v| v == "0.02").await,
+            Some("0.02".into()),
+            "/diagnostics never reported the new factor"
+        );
+
+        // Services: the twin waits for sensors, so it stands at t = 0 until stepped.
+        let r = call(&node, &step, TriggerRequest::default()).await;
+        assert!(
+            !r.success && r.message.contains("pause the twin first"),
+            "{r:?}"
+        );
+        let r = call(&node, &pause, TriggerRequest::default()).await;
+        assert!(r.success, "{r:?}");
+        assert_eq!(
+            diagnostic(&mut stream, "paused", |v| v == "true").await,
+            Some("true".into())
+        );
+        let r = call(&node, &step, TriggerRequest::default()).await;
+        assert!(r.success && r.message.contains("to 0.100 s"), "{r:?}");
+        assert_eq!(
+            diagnostic(&mut stream, "sim_time_s", |v| v != "0.000000").await,
+            Some("0.100000".into()),
+            "one step of --max-chunk-s"
+        );
+        let r = call(&node, &reset, TriggerRequest::default()).await;
+        assert!(r.success, "{r:?}");
+        assert_eq!(
+            diagnostic(&mut stream, "sim_time_s", |v| v == "0.000000").await,
+            Some("0.000000".into()),
+            "back to the start"
+        );
+        let r = call(&node, &resume, TriggerRequest::default()).await;
+        assert!(r.success, "{r:?}");
+        assert_eq!(
+            diagnostic(&mut stream, "paused", |v| v == "false").await,
+            Some("false".into())
+        );
     });
 }
