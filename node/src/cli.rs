@@ -53,6 +53,11 @@ pub struct RunArgs {
     /// Hold at t = 0 until the first sensor sample: simulated time 0 is then the flume's start.
     #[arg(long)]
     pub wait_for_sensors: bool,
+    /// What the gauges publish: a level (flume_msgs/WaterLevel), or an ultrasonic range down to
+    /// the water (sensor_msgs/Range; level = the parameter gauge_mount_height_m.<gauge>, by
+    /// default the flume's height, minus the range).
+    #[arg(long, value_enum, default_value_t = GaugeMsg::WaterLevel)]
+    pub gauge_msg: GaugeMsg,
     /// DDS domain (as ROS_DOMAIN_ID).
     #[arg(long, env = "ROS_DOMAIN_ID", default_value_t = 0)]
     pub domain_id: u16,
@@ -65,6 +70,12 @@ pub struct RunArgs {
     /// Stop once simulated time reaches this, s (scripted runs and tests).
     #[arg(long, value_name = "T_S", value_parser = positive)]
     pub until: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum GaugeMsg {
+    WaterLevel,
+    Range,
 }
 
 fn positive(s: &str) -> Result<f64, String> {

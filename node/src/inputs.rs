@@ -29,6 +29,12 @@ pub enum Rejection {
     FromTheFuture {
         ahead: f64,
     },
+    /// A range reading outside the sensor's own bounds (no echo, or too close), m.
+    RangeOutOfBounds {
+        range: f64,
+        min: f64,
+        max: f64,
+    },
 }
 
 impl Rejection {
@@ -41,6 +47,7 @@ impl Rejection {
             Rejection::LevelOutsideFlume { .. } => "level_outside_flume",
             Rejection::OutOfOrder { .. } => "out_of_order",
             Rejection::FromTheFuture { .. } => "future_stamp",
+            Rejection::RangeOutOfBounds { .. } => "range_out_of_bounds",
         }
     }
 }
@@ -62,6 +69,9 @@ impl fmt::Display for Rejection {
             ),
             Rejection::FromTheFuture { ahead } => {
                 write!(f, "stamp {ahead:.3} s ahead of this node's clock")
+            }
+            Rejection::RangeOutOfBounds { range, min, max } => {
+                write!(f, "range {range} m outside the sensor's {min} to {max} m")
             }
         }
     }
@@ -161,6 +171,36 @@ impl InputGate {
         self.settle(sensor, stamp, r)
     }
 
+    /// Checks an ultrasonic gauge's range reading (sensor_msgs/Range: the distance down to the
+    /// water from a sensor mounted `mount_m` above the flume floor) and gives the level,
+    /// `mount_m - range`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn range(
+        &mut self,
+        sensor: &str,
+        stamp: f64,
+        range: f64,
+        bounds: (f64, f64),
+        mount_m: f64,
+        now: f64,
+    ) -> Result<f64, Rejection> {
+        let (min, max) = bounds;
+        let r = self.order(sensor, stamp, now).and_then(|()| {
+            if !range.is_finite() {
+                Err(Rejection::NonFinite)
+            } else if range < min || range > max {
+                Err(Rejection::RangeOutOfBounds { range, min, max })
+            } else {
+                Ok(())
+            }
+        });
+        if let Err(e) = r {
+            return self.settle(sensor, stamp, Err(e)).map(|()| 0.0);
+        }
+        let level = mount_m - range;
+        self.level(sensor, stamp, level, now).map(|()| level)
+    }
+
     /// Checks a water level sample (m above the flume floor).
     pub fn level(
         &mut self,
@@ -250,5 +290,29 @@ mod tests {
         // P2's first sample may be older than P1's last.
         assert_eq!(g.level("p2", 4.0, 0.06, 5.2), Ok(()));
         assert_eq!(g.refused().get("level_outside_flume"), Some(&2));
+    }
+
+    #[test]
+    fn a_range_reading_becomes_the_level_under_the_sensor() {
+        let mut g = gate();
+        // Mounted 0.25 m above the floor, 0.18 m down to the water: 0.07 m of water.
+        let level = g
+            .range("p1", 1.0, 0.18, (0.02, 0.4), 0.25, 1.0)
+            .expect("valid");
+        assert!((level - 0.07).abs() < 1e-12);
+        assert!(matches!(
+            g.range("p1", 1.1, 0.5, (0.02, 0.4), 0.25, 1.1),
+            Err(Rejection::RangeOutOfBounds { .. })
+        ));
+        assert_eq!(
+            g.range("p1", 1.2, f64::INFINITY, (0.02, 0.4), 0.25, 1.2),
+            Err(Rejection::NonFinite)
+        );
+        // A level the flume cannot hold: the sensor mounted above its top reads too short.
+        assert!(matches!(
+            g.range("p1", 1.3, 0.03, (0.02, 0.4), 0.5, 1.3),
+            Err(Rejection::LevelOutsideFlume { .. })
+        ));
+        assert_eq!(g.refused_total(), 3);
     }
 }

@@ -5,7 +5,7 @@
 //! out as the bed profile, the eroded mass, the gauge comparison, `/clock` and, once a
 //! second, `/diagnostics`. This module knows topics and times, not SPH.
 
-use crate::cli::RunArgs;
+use crate::cli::{GaugeMsg, RunArgs};
 use crate::inputs::{InputGate, Limits};
 use crate::pacer::Pacer;
 use crate::ros_args::{ParamValue, RosArgs};
@@ -18,7 +18,7 @@ use flume_msgs::flume_msgs::{
     BedProfile, Discharge, ErodedMass, GaugeComparison, GaugeResidual, WaterLevel,
 };
 use flume_msgs::rosgraph_msgs::Clock;
-use flume_msgs::sensor_msgs::PointCloud2;
+use flume_msgs::sensor_msgs::{PointCloud2, Range};
 use flume_msgs::std_msgs::Header;
 use flume_msgs::std_srvs::{TriggerRequest, TriggerResponse};
 use flume_msgs::visualization_msgs::MarkerArray;
@@ -101,19 +101,38 @@ struct Settings {
     publish_rate_hz: f64,
     stale_after_s: f64,
     frame_id: String,
+    /// The gauges' topic names (p1, p2, ...) and the height of each range sensor above the
+    /// flume floor, m (parameters `gauge_mount_height_m.p1`, ...).
+    gauges: Vec<String>,
+    mount_height_m: Vec<f64>,
 }
 
 impl Settings {
-    fn new(args: &RunArgs, params: &[(String, ParamValue)]) -> Result<Settings> {
+    /// Settings for gauges `gauges` (topic names), range sensors mounted at `flume_top_m`
+    /// unless a parameter says otherwise.
+    fn new(
+        args: &RunArgs,
+        gauges: &[String],
+        flume_top_m: f64,
+        params: &[(String, ParamValue)],
+    ) -> Result<Settings> {
         let mut s = Settings {
             target_rtf: args.target_rtf,
             publish_rate_hz: args.publish_rate_hz,
             stale_after_s: args.stale_after_s,
             frame_id: "flume".into(),
+            gauges: gauges.to_vec(),
+            mount_height_m: vec![flume_top_m; gauges.len()],
         };
         for (name, value) in params {
-            if !PARAMETERS.contains(&name.as_str()) {
-                log::warn!("parameter {name} is not one of flume_twin's; ignored");
+            let gauge = name.strip_prefix(MOUNT_HEIGHT);
+            let known = match gauge {
+                // A parameter file may serve cases with more gauges than this one.
+                Some(g) => s.gauges.iter().any(|n| n == g),
+                None => PARAMETERS.contains(&name.as_str()),
+            };
+            if !known {
+                log::warn!("parameter {name} is not one of flume_twin's for this case; ignored");
                 continue;
             }
             s.apply(name, value)
@@ -143,14 +162,20 @@ impl Settings {
                     return Err(format!("must be true or false, got {value:?}"));
                 }
             }
-            other => return Err(format!("{other} is not a parameter of flume_twin")),
+            other => match other
+                .strip_prefix(MOUNT_HEIGHT)
+                .and_then(|g| self.gauges.iter().position(|n| n == g))
+            {
+                Some(k) => self.mount_height_m[k] = number()?,
+                None => return Err(format!("{other} is not a parameter of flume_twin")),
+            },
         }
         Ok(())
     }
 
     /// The values to declare to ROS, as `ros2 param` shows them.
-    fn declared(&self) -> Vec<(&'static str, ParameterValue)> {
-        vec![
+    fn declared(&self) -> Vec<(String, ParameterValue)> {
+        let mut out: Vec<(String, ParameterValue)> = vec![
             (
                 "target_real_time_factor",
                 ParameterValue::Double(self.target_rtf),
@@ -162,10 +187,20 @@ impl Settings {
             ("stale_after_s", ParameterValue::Double(self.stale_after_s)),
             ("frame_id", ParameterValue::String(self.frame_id.clone())),
         ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+        for (g, h) in self.gauges.iter().zip(&self.mount_height_m) {
+            out.push((format!("{MOUNT_HEIGHT}{g}"), ParameterValue::Double(*h)));
+        }
+        out
     }
 }
 
-/// The node's parameters (use_sim_time is ROS's own, declared by every node).
+/// The prefix of the range sensors' mount heights: `gauge_mount_height_m.p1`, m.
+const MOUNT_HEIGHT: &str = "gauge_mount_height_m.";
+
+/// The node's parameters besides the mount heights (use_sim_time is ROS's own).
 const PARAMETERS: [&str; 5] = [
     "target_real_time_factor",
     "publish_rate_hz",
@@ -196,7 +231,7 @@ fn live_parameters(options: NodeOptions, live: &Arc<Mutex<Settings>>) -> NodeOpt
     let initial = lock(live);
     let mut options = options;
     for (name, value) in initial.declared() {
-        options = options.declare_parameter(name, value);
+        options = options.declare_parameter(&name, value);
     }
     options
         .parameter_validator(Box::new(move |name, value| {
@@ -214,6 +249,19 @@ fn live_parameters(options: NodeOptions, live: &Arc<Mutex<Settings>>) -> NodeOpt
             log::info!("parameter {name} set to {value:?}");
             Ok(())
         }))
+}
+
+/// What a gauge sensor said: a level, or an ultrasonic range down to the water.
+#[derive(Debug, Clone, Copy)]
+enum Reading {
+    Level(f64),
+    Range { range: f64, min: f64, max: f64 },
+}
+
+#[derive(Debug, Clone, Copy)]
+struct GaugeSample {
+    stamp_s: f64,
+    reading: Reading,
 }
 
 /// A gauge's accepted readings, oldest first, from the one in force at the last output on.
@@ -253,7 +301,19 @@ pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
     let namespace = ros.namespace.clone().unwrap_or_else(|| "/".into());
     let node_name = ros.node_name.clone().unwrap_or_else(|| "flume_twin".into());
     let fqn = format!("{}/{node_name}", namespace.trim_end_matches('/'));
-    let settings = Settings::new(args, &ros.parameters(&fqn)?)?;
+    let vertical = case.dim() - 1;
+    let gauges: Vec<String> = case
+        .observations
+        .gauges
+        .iter()
+        .map(|g| g.name.to_lowercase())
+        .collect();
+    let settings = Settings::new(
+        args,
+        &gauges,
+        case.domain.max_m[vertical] - case.domain.min_m[vertical],
+        &ros.parameters(&fqn)?,
+    )?;
     let derived = flume_solver::case::derive(&case);
     let limits = Limits {
         max_discharge_m3_per_s: flume_solver::flume::MAX_INLET_MACH
@@ -321,17 +381,25 @@ async fn serve(
     tokio::spawn(spinner.spin());
 
     let inflow_sub = subscription::<Discharge>(&mut node, &ros, "inflow", reliable(10))?;
-    let gauge_subs = gauge_names
-        .iter()
-        .map(|g| {
-            subscription::<WaterLevel>(
+    let mut level_subs = Vec::new();
+    let mut range_subs = Vec::new();
+    for g in &gauge_names {
+        let topic = format!("gauges/{}", g.to_lowercase());
+        match args.gauge_msg {
+            GaugeMsg::WaterLevel => level_subs.push(subscription::<WaterLevel>(
                 &mut node,
                 &ros,
-                &format!("gauges/{}", g.to_lowercase()),
+                &topic,
                 sensor_data(),
-            )
-        })
-        .collect::<Result<Vec<_>>>()?;
+            )?),
+            GaugeMsg::Range => range_subs.push(subscription::<Range>(
+                &mut node,
+                &ros,
+                &topic,
+                sensor_data(),
+            )?),
+        }
+    }
     let bed_pub = publisher::<BedProfile>(
         &mut node,
         &ros,
@@ -397,12 +465,36 @@ async fn serve(
         }));
 
     let mut inflow_stream = Box::pin(inflow_sub.async_stream());
-    let mut gauge_stream = futures::stream::select_all(
-        gauge_subs
-            .iter()
-            .enumerate()
-            .map(|(i, s)| Box::pin(s.async_stream().map(move |r| (i, r)))),
-    );
+    type GaugeStream<'a> = std::pin::Pin<
+        Box<dyn futures::Stream<Item = (usize, Result<GaugeSample, String>)> + Send + 'a>,
+    >;
+    let streams: Vec<GaugeStream> = level_subs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            Box::pin(s.async_stream().map(move |r| {
+                let sample = r.map(|(m, _)| GaugeSample {
+                    stamp_s: m.header.stamp.as_secs_f64(),
+                    reading: Reading::Level(m.level_m),
+                });
+                (i, sample.map_err(|e| format!("{e:?}")))
+            })) as GaugeStream
+        })
+        .chain(range_subs.iter().enumerate().map(|(i, s)| {
+            Box::pin(s.async_stream().map(move |r| {
+                let sample = r.map(|(m, _)| GaugeSample {
+                    stamp_s: m.header.stamp.as_secs_f64(),
+                    reading: Reading::Range {
+                        range: f64::from(m.range),
+                        min: f64::from(m.min_range),
+                        max: f64::from(m.max_range),
+                    },
+                });
+                (i, sample.map_err(|e| format!("{e:?}")))
+            })) as GaugeStream
+        }))
+        .collect();
+    let mut gauge_stream = futures::stream::select_all(streams);
     let mut gate = InputGate::new(limits);
     let mut pacer = Pacer::new(
         settings.target_rtf,
@@ -444,12 +536,19 @@ async fn serve(
                 }
             },
             Some((g, r)) = gauge_stream.next() => match r {
-                Ok((msg, _)) => {
-                    let stamp = msg.header.stamp.as_secs_f64();
+                Ok(sample) => {
+                    let stamp = sample.stamp_s;
                     let name = &gauge_names[g];
-                    if gate.level(name, stamp, msg.level_m, now_s()).is_ok() {
+                    let level = match sample.reading {
+                        Reading::Level(level) => gate.level(name, stamp, level, now_s()).map(|()| level),
+                        Reading::Range { range, min, max } => {
+                            let mount = settings.mount_height_m[g];
+                            gate.range(name, stamp, range, (min, max), mount, now_s())
+                        }
+                    };
+                    if let Ok(level) = level {
                         pacer.heard(stamp);
-                        measured[g].push(stamp, msg.level_m);
+                        measured[g].push(stamp, level);
                     }
                 }
                 Err(e) => {
@@ -792,6 +891,8 @@ mod tests {
             RosArgs::parse(&["--params-file", file, "-p", "publish_rate_hz:=4"]).expect("parses");
         let s = Settings::new(
             &run_args(&[]),
+            &["p1".to_string()],
+            0.3,
             &ros.parameters("/flume/flume_twin").expect("reads"),
         )
         .expect("valid");
@@ -799,6 +900,35 @@ mod tests {
         assert_eq!(s.publish_rate_hz, 4.0, "-p wins over the file");
         assert_eq!(s.stale_after_s, 2.0);
         assert_eq!(s.frame_id, "flume");
+        assert_eq!(s.mount_height_m, vec![0.3], "the file's p1");
+        let ros = RosArgs::parse(&["-p", "gauge_mount_height_m.p1:=0.25"]).expect("parses");
+        let s = Settings::new(
+            &run_args(&[]),
+            &["p1".to_string()],
+            0.3,
+            &ros.parameters("/flume_twin").expect("reads"),
+        )
+        .expect("valid");
+        assert_eq!(s.mount_height_m, vec![0.25]);
+        // The file's p2 and p3 are not in this case: ignored, as is a p9 on the command line.
+        let ros = RosArgs::parse(&["-p", "gauge_mount_height_m.p9:=0.25"]).expect("parses");
+        let s = Settings::new(
+            &run_args(&[]),
+            &["p1".to_string()],
+            0.3,
+            &ros.parameters("/flume_twin").expect("reads"),
+        )
+        .expect("ignored");
+        assert_eq!(s.mount_height_m, vec![0.3]);
+        let mut live = s.clone();
+        assert!(
+            live.apply("gauge_mount_height_m.p9", &ParamValue::Double(0.2))
+                .is_err()
+        );
+        assert!(
+            live.apply("gauge_mount_height_m.p1", &ParamValue::Double(-0.2))
+                .is_err()
+        );
         for (bad, reason) in [
             ("target_real_time_factor:=-1", "must be a positive number"),
             ("publish_rate_hz:=fast", "must be a positive number"),
@@ -807,6 +937,8 @@ mod tests {
             let ros = RosArgs::parse(&["-p", bad]).expect("parses");
             let err = Settings::new(
                 &run_args(&[]),
+                &["p1".to_string()],
+                0.3,
                 &ros.parameters("/flume_twin").expect("reads"),
             )
             .expect_err("refused");

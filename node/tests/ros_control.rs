@@ -1,10 +1,15 @@
 //! The twin controlled from another process (here with ros2-client): parameters through the
 //! standard `rcl_interfaces` services `ros2 param` uses (a bad value refused with its reason,
 //! a good one taking effect, as the node's own /diagnostics then reports), and the pause,
-//! step, resume and reset services (std_srvs/Trigger).
+//! step, resume and reset services (std_srvs/Trigger); and a gauge that publishes an
+//! ultrasonic range, whose level is its mount height (a parameter) minus the range.
 
 use flume_msgs::RosMessage;
+use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::DiagnosticArray;
+use flume_msgs::flume_msgs::GaugeComparison;
+use flume_msgs::sensor_msgs::Range;
+use flume_msgs::std_msgs::Header;
 use flume_msgs::std_srvs::{TriggerRequest, TriggerResponse};
 use futures::StreamExt;
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
@@ -127,14 +132,19 @@ fn parameters_and_services_from_another_process_control_the_twin() {
                     .expect("utf-8"),
                 "--loopback",
                 "--wait-for-sensors",
+                "--gauge-msg",
+                "range",
                 "--ros-args",
                 "-r",
                 "__ns:=/flume_params",
                 "-p",
                 "target_real_time_factor:=0.5",
+                "-p",
+                "gauge_mount_height_m.p1:=0.2",
             ])
             .stdout(Stdio::null())
-            .stderr(Stdio::null())
+            // A twin that fails to start says why in the test's output.
+            .stderr(Stdio::inherit())
             .spawn()
             .expect("the twin starts"),
     );
@@ -188,6 +198,30 @@ fn parameters_and_services_from_another_process_control_the_twin() {
             .expect("topic");
         let diagnostics = node
             .create_subscription::<DiagnosticArray>(&diag_topic, Some(diag_qos))
+            .expect("subscription");
+        let range_qos = QosProfile::publisher_default()
+            .reliability_best_effort()
+            .history(History::KeepLast { depth: 5 });
+        let range_topic = node
+            .create_topic(
+                &Name::new("/flume_params/gauges", "p1").expect("name"),
+                MessageTypeName::new(Range::DEF.package, Range::DEF.name),
+                &range_qos,
+            )
+            .expect("topic");
+        let range_pub = node
+            .create_publisher::<Range>(&range_topic, Some(range_qos))
+            .expect("publisher");
+        let compare_qos = QosProfile::publisher_default().history(History::KeepLast { depth: 10 });
+        let compare_topic = node
+            .create_topic(
+                &Name::new("/flume_params/gauges", "predicted").expect("name"),
+                MessageTypeName::new(GaugeComparison::DEF.package, GaugeComparison::DEF.name),
+                &compare_qos,
+            )
+            .expect("topic");
+        let comparisons = node
+            .create_subscription::<GaugeComparison>(&compare_topic, Some(compare_qos))
             .expect("subscription");
 
         let refused = call(
@@ -278,5 +312,49 @@ fn parameters_and_services_from_another_process_control_the_twin() {
             diagnostic(&mut stream, "paused", |v| v == "false").await,
             Some("false".into())
         );
+
+        // An ultrasonic gauge (sensor_msgs/Range) 0.2 m above the floor reading 0.13 m: the
+        // twin measures 0.07 m of water and compares its prediction with that.
+        let mut compared = Box::pin(comparisons.async_stream());
+        let range = 0.13f32;
+        let expected = 0.2 - f64::from(range);
+        let seen = tokio::time::timeout(Duration::from_secs(30), async {
+            loop {
+                let now = std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .expect("clock")
+                    .as_secs_f64();
+                let sample = Range {
+                    header: Header {
+                        stamp: Time::from_secs_f64(now).expect("now"),
+                        frame_id: "p1".into(),
+                    },
+                    radiation_type: Range::ULTRASOUND,
+                    field_of_view: 0.1,
+                    min_range: 0.02,
+                    max_range: 0.4,
+                    range,
+                    variance: 0.0,
+                };
+                let _ = range_pub.async_publish(sample).await;
+                let next = tokio::time::timeout(Duration::from_millis(100), compared.next()).await;
+                if let Ok(Some(Ok((msg, _)))) = next
+                    && let Some(g) = msg.gauges.first()
+                    && g.measured_m.is_finite()
+                {
+                    return (g.name.clone(), g.measured_m, g.predicted_m, g.residual_m);
+                }
+            }
+        })
+        .await
+        .expect("a gauge comparison with the range gauge's level");
+        eprintln!("range gauge: {seen:?}");
+        assert_eq!(seen.0, "P1");
+        assert!(
+            (seen.1 - expected).abs() < 1e-12,
+            "measured {} vs {expected}",
+            seen.1
+        );
+        assert!((seen.3 - (seen.2 - seen.1)).abs() < 1e-12);
     });
 }
