@@ -281,7 +281,9 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
         ("non_finite", "1"),
         ("negative_discharge", "1"),
         ("level_outside_flume", "1"),
-        ("rejected_inputs", "3"),
+        ("future_stamp", "1"),
+        ("out_of_order", "1"),
+        ("rejected_inputs", "5"),
         ("particles", particles.as_str()),
     ] {
         assert_eq!(values[key], want, "{key} in {values}");

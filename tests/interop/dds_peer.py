@@ -4,8 +4,8 @@ plays the flume's sensors to the twin and records what the twin publishes.
 It publishes, every 0.1 s of wall time for DURATION_S, a discharge on `<ns>/inflow`
 (flume_msgs/Discharge, reliable) and a level on `<ns>/gauges/p1` (flume_msgs/WaterLevel, best
 effort), each stamped with this machine's clock; in the middle it also sends what the twin must
-refuse (a NaN and a negative discharge, a level above the flume, a std_msgs/String on the inflow
-topic). It subscribes to `<ns>/bed_profile`, `<ns>/eroded_mass`, `<ns>/gauges/predicted`,
+refuse (a NaN and a negative discharge, a level above the flume, discharges stamped 10 s ahead
+and 5 s behind, a std_msgs/String on the inflow topic). It subscribes to `<ns>/bed_profile`, `<ns>/eroded_mass`, `<ns>/gauges/predicted`,
 `<ns>/particles`, `<ns>/bed_marker`, `/clock` and `/diagnostics`, and prints each message it receives as one JSON line, with what it
 sent first (`{"sent": ...}` lines), until SECONDS have passed or the twin's last output came.
 
@@ -317,6 +317,8 @@ def main() -> None:
                 inflow.write(Discharge(stamp(now), float("nan")))
                 inflow.write(Discharge(stamp(now), -1.0e-4))
                 p1.write(WaterLevel(stamp(now), 5.0))
+                inflow.write(Discharge(stamp(now + 10.0), 5.0e-4))
+                inflow.write(Discharge(stamp(now - 5.0), 5.0e-4))
                 wrong.write(String("not a discharge"))
                 emit("sent_bad", {"t": now})
         for kind, reader in readers.items():
