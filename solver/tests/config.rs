@@ -29,7 +29,10 @@ fn every_shipped_case_parses() {
     let mut n = 0;
     for entry in std::fs::read_dir(&dir).expect("launch_configs") {
         let path = entry.expect("entry").path();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default();
         // ROS parameter files (`*.params.yaml`) live beside the cases.
         if name.ends_with(".yaml") && !name.ends_with(".params.yaml") {
             Case::from_path(&path).unwrap_or_else(|e| panic!("{e}"));
