@@ -1,21 +1,14 @@
 //! The flume-twin binary as a user runs it: bad case files, a short simulate run and its
 //! output files, and the missing-adapter message.
-//!
-//! GPU tests skip with a note when no adapter is found, except under CI=true (CI has lavapipe),
-//! where a missing adapter is a failure. They run one at a time: lavapipe uses every core.
 
+mod common;
+
+use common::{gpu, repo_file};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::{Mutex, MutexGuard};
 
 const BIN: &str = env!("CARGO_BIN_EXE_flume-twin");
-
-static GPU: Mutex<()> = Mutex::new(());
-
-fn repo_file(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
-}
 
 /// A fresh, empty directory for one test's files.
 fn scratch(name: &str) -> PathBuf {
@@ -33,21 +26,6 @@ fn flume_twin(args: &[&str]) -> Output {
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// Holds the GPU lock if an adapter is there; None (after a note) if the test should skip.
-fn gpu() -> Option<MutexGuard<'static, ()>> {
-    let guard = GPU.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    match flume_solver::GpuContext::new() {
-        Ok(_) => Some(guard),
-        Err(e) if std::env::var("CI").as_deref() == Ok("true") => {
-            panic!("CI=true and no GPU adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("note: skipping a GPU test, no adapter: {e}");
-            None
-        }
-    }
 }
 
 /// The verification case with one textual change, written to `dir`.

@@ -5,6 +5,9 @@
 //! ultrasonic range, whose level is its mount height (a parameter) minus the range.
 
 use flume_msgs::RosMessage;
+mod common;
+
+use common::{gpu, repo_file};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::DiagnosticArray;
 use flume_msgs::flume_msgs::GaugeComparison;
@@ -22,15 +25,8 @@ use ros2_client::{
     QosProfile, ServiceMapping, ServiceTypeName,
 };
 use std::net::Ipv4Addr;
-use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
-
-fn repo_file(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join(rel)
-}
 
 /// Kills the twin however the test ends.
 struct Twin(Child);
@@ -115,14 +111,7 @@ where
 
 #[test]
 fn parameters_and_services_from_another_process_control_the_twin() {
-    if flume_solver::GpuContext::new().is_err() {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true and no GPU adapter"
-        );
-        eprintln!("note: skipping a GPU test, no adapter");
-        return;
-    }
+    let Some(_gpu) = gpu() else { return };
     let _twin = Twin(
         Command::new(env!("CARGO_BIN_EXE_flume-twin"))
             .args([

@@ -3,33 +3,13 @@
 //! publishes; the values it receives must be the ones the solver produced (the node's own
 //! `--out` CSV files), and the bad samples it slips in must be refused and counted.
 
+mod common;
+
+use common::{gpu, repo_file};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
-use std::sync::{Mutex, MutexGuard};
-
-static GPU: Mutex<()> = Mutex::new(());
-
-fn repo_file(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join(rel)
-}
-
-fn gpu() -> Option<MutexGuard<'static, ()>> {
-    let guard = GPU.lock().unwrap_or_else(|p| p.into_inner());
-    match flume_solver::GpuContext::new() {
-        Ok(_) => Some(guard),
-        Err(e) if std::env::var("CI").as_deref() == Ok("true") => {
-            panic!("CI=true and no GPU adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("note: skipping a GPU test, no adapter: {e}");
-            None
-        }
-    }
-}
 
 fn have_cyclonedds() -> bool {
     let ok = Command::new("python3")
