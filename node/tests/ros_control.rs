@@ -59,7 +59,8 @@ where
     Req: ros2_client::Message + 'static,
     Resp: ros2_client::Message + 'static,
 {
-    tokio::time::timeout(Duration::from_secs(30), client.wait_for_service(node))
+    // The twin compiles its shaders first: on a busy software adapter that can take a while.
+    tokio::time::timeout(Duration::from_secs(120), client.wait_for_service(node))
         .await
         .expect("the twin's parameter service appears");
     let id = client.async_send_request(request).await.expect("sent");
