@@ -174,7 +174,6 @@ impl InputGate {
     /// Checks an ultrasonic gauge's range reading (sensor_msgs/Range: the distance down to the
     /// water from a sensor mounted `mount_m` above the flume floor) and gives the level,
     /// `mount_m - range`.
-    #[allow(clippy::too_many_arguments)]
     pub fn range(
         &mut self,
         sensor: &str,

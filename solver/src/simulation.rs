@@ -887,6 +887,10 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
     let dp = case.numerics.dp_m;
     let parking = case::Parking::new(case, derived.h);
     let (lo, hi) = (&case.domain.min_m, &case.domain.max_m);
+    // An empty box (y_max = y_min) when there is no bottom outlet.
+    let duct = f.bottom_outlet.as_ref().map_or([0.0; 4], |o| {
+        [o.x_min_m, o.y_min_m, o.y_max_m, o.velocity_m_s]
+    });
     FlumeGpu {
         enabled: 1,
         water_phase: 1 + case.sediment_phases().map_or(0, |(_, w)| w) as u32,
@@ -905,10 +909,10 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
         parking_x0: parking.x0 as f32,
         parking_y0: parking.y0 as f32,
         parking_dp: dp as f32,
-        duct_x_min: f.bottom_outlet.as_ref().map_or(0.0, |o| o.x_min_m) as f32,
-        duct_y_min: f.bottom_outlet.as_ref().map_or(0.0, |o| o.y_min_m) as f32,
-        duct_y_max: f.bottom_outlet.as_ref().map_or(0.0, |o| o.y_max_m) as f32,
-        duct_u: f.bottom_outlet.as_ref().map_or(0.0, |o| o.velocity_m_s) as f32,
+        duct_x_min: duct[0] as f32,
+        duct_y_min: duct[1] as f32,
+        duct_y_max: duct[2] as f32,
+        duct_u: duct[3] as f32,
         pad: 0.0,
     }
 }
