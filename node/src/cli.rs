@@ -23,12 +23,22 @@ pub enum Command {
     /// The twin as a ROS 2 node: sensor topics in, bed profile, eroded mass, gauge comparison,
     /// /clock and /diagnostics out. ROS arguments follow `--ros-args`, as ros2 run passes them.
     Run(RunArgs),
+    /// Feed a recorded session's sensor topics to the twin in-process (no DDS), as fast as
+    /// the adapter goes or paced, and record the twin's outputs.
+    Replay(ReplayArgs),
+    /// Write a synthetic flume session (the inflow and gauge topics) as an MCAP recording:
+    /// a simple hydraulic model of the case's flume plus a stated sensor noise model.
+    MakeSession(MakeSessionArgs),
 }
 
 #[derive(Debug, Args)]
 pub struct RunArgs {
     /// Case file (YAML) with an open flume, e.g. launch_configs/ulbra_flume.yaml.
     pub case: PathBuf,
+    /// Override a field of the case, e.g. `--set numerics.dp_m=0.01` (repeatable; a number
+    /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// Real-time factor to run at when no sensor drives the twin (simulated s per wall s).
     #[arg(long = "target-rtf", value_name = "X", default_value_t = 1.0, value_parser = positive)]
     pub target_rtf: f64,
@@ -90,6 +100,10 @@ fn positive(s: &str) -> Result<f64, String> {
 pub struct SimulateArgs {
     /// Case file (YAML), e.g. launch_configs/dambreak_water.yaml.
     pub case: PathBuf,
+    /// Override a field of the case, e.g. `--set numerics.dp_m=0.01` (repeatable; a number
+    /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// Simulated time to stop at, s [default: the case's time.end_s].
     #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
     pub until: Option<f64>,
@@ -106,6 +120,76 @@ pub struct SimulateArgs {
     /// discharge held until the next row's time.
     #[arg(long, value_name = "FILE")]
     pub inflow: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The recording (MCAP) whose inflow and gauge topics drive the twin.
+    pub recording: PathBuf,
+    /// Case file (YAML) with an open flume, e.g. launch_configs/ulbra_flume.yaml.
+    #[arg(long, value_name = "CASE")]
+    pub config: PathBuf,
+    /// Override a field of the case, e.g. `--set numerics.dp_m=0.01` (repeatable; a number
+    /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Write the replayed inputs and the twin's outputs to this recording (MCAP).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk.
+    #[arg(long, value_name = "DIR")]
+    pub csv: Option<PathBuf>,
+    /// Pace the replay at this many simulated seconds per wall second [default: as fast as
+    /// the adapter goes].
+    #[arg(long, value_name = "X", value_parser = positive)]
+    pub rate: Option<f64>,
+    /// Replay only these recorded topics (comma-separated) [default: every inflow and gauge
+    /// topic of the case].
+    #[arg(long, value_name = "T1,T2,...", value_delimiter = ',')]
+    pub topics: Vec<String>,
+    /// Start this far into the recording, s; the discharge in force then holds from the start.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub start_s: f64,
+    /// Stop at this simulated time, s [default: the last replayed sample].
+    #[arg(long, value_name = "T_S", value_parser = positive)]
+    pub until: Option<f64>,
+    /// The solver's chunk: outputs are written at multiples of it, s.
+    #[arg(long, value_name = "S", default_value_t = 0.1, value_parser = positive)]
+    pub output_interval_s: f64,
+    /// A gauge whose last sample is older than this at an output is flagged stale, s.
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = positive)]
+    pub stale_after_s: f64,
+    /// How far ahead of its logging time a sample's stamp may be, s.
+    #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = positive)]
+    pub future_tolerance_s: f64,
+}
+
+#[derive(Debug, Args)]
+pub struct MakeSessionArgs {
+    /// Case file (YAML) with an open flume.
+    pub case: PathBuf,
+    /// Override a field of the case, e.g. `--set numerics.dp_m=0.01` (repeatable; a number
+    /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// The recording to write.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Length of the session, s.
+    #[arg(long, value_name = "S", default_value_t = 75.0, value_parser = positive)]
+    pub duration_s: f64,
+    /// When the discharge changes, s (on a filled flume).
+    #[arg(long, value_name = "S", default_value = "40", value_parser = positive)]
+    pub change_at_s: Option<f64>,
+    /// The discharge from then on, m3/h.
+    #[arg(long, value_name = "Q", default_value = "2.5", value_parser = positive)]
+    pub change_to_m3_per_h: Option<f64>,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 2018)]
+    pub seed: u64,
+    /// The session's start, s since the epoch [default: 2026-11-21 09:00 UTC].
+    #[arg(long, value_name = "S", default_value_t = 1_795_251_600.0, value_parser = positive)]
+    pub start_epoch_s: f64,
 }
 
 #[derive(Debug, Args)]

@@ -3,17 +3,22 @@
 //! The node moves data between the world and the solver and knows nothing about SPH; every
 //! subcommand lives in its own module and `main` only dispatches.
 
+mod bag;
 mod bench;
 mod cli;
 mod inflow;
 mod inputs;
+mod observed;
 mod output;
 mod pacer;
+mod replay;
 mod ros_args;
 mod run;
+mod session;
 mod simulate;
 mod solver_thread;
 mod table;
+mod topics;
 mod visual;
 
 use clap::Parser;
@@ -36,6 +41,8 @@ fn main() -> ExitCode {
         cli::Command::Simulate(args) => simulate::run(&args),
         cli::Command::Bench(args) => bench::run(&args),
         cli::Command::Run(args) => run::run(&args, &ros_args),
+        cli::Command::Replay(args) => replay::run(&args),
+        cli::Command::MakeSession(args) => session::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

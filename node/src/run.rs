@@ -5,18 +5,19 @@
 //! out as the bed profile, the eroded mass, the gauge comparison, `/clock` and, once a
 //! second, `/diagnostics`. This module knows topics and times, not SPH.
 
+use crate::bag::TopicQos;
 use crate::cli::{GaugeMsg, RunArgs};
-use crate::inputs::{InputGate, Limits};
+use crate::inputs::{GaugeSample, InputGate, Limits, Reading, Readings};
+use crate::observed::{bed_profile, comparison, eroded_mass};
 use crate::pacer::Pacer;
 use crate::ros_args::{ParamValue, RosArgs};
 use crate::solver_thread::{self, Command, Report};
+use crate::topics;
 use crate::visual;
 use anyhow::{Context as _, Result, anyhow, bail};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
-use flume_msgs::flume_msgs::{
-    BedProfile, Discharge, ErodedMass, GaugeComparison, GaugeResidual, WaterLevel,
-};
+use flume_msgs::flume_msgs::{BedProfile, Discharge, ErodedMass, GaugeComparison, WaterLevel};
 use flume_msgs::rosgraph_msgs::Clock;
 use flume_msgs::sensor_msgs::{PointCloud2, Range};
 use flume_msgs::std_msgs::Header;
@@ -44,18 +45,19 @@ fn now_s() -> f64 {
         .map_or(0.0, |d| d.as_secs_f64())
 }
 
-fn reliable(depth: usize) -> QosProfile {
-    QosProfile::publisher_default()
-        .reliability_reliable(WhenFull::DEFAULT)
-        .durability(Durability::Volatile)
-        .history(History::KeepLast { depth })
-}
-
-fn sensor_data() -> QosProfile {
-    QosProfile::subscription_default()
-        .reliability_best_effort()
-        .durability(Durability::Volatile)
-        .history(History::KeepLast { depth: 5 })
+fn qos(t: TopicQos) -> QosProfile {
+    let q = QosProfile::publisher_default()
+        .durability(if t.transient_local {
+            Durability::TransientLocal
+        } else {
+            Durability::Volatile
+        })
+        .history(History::KeepLast { depth: t.depth });
+    if t.reliable {
+        q.reliability_reliable(WhenFull::DEFAULT)
+    } else {
+        q.reliability_best_effort()
+    }
 }
 
 fn type_name(def: &MsgDef) -> MessageTypeName {
@@ -251,47 +253,10 @@ fn live_parameters(options: NodeOptions, live: &Arc<Mutex<Settings>>) -> NodeOpt
         }))
 }
 
-/// What a gauge sensor said: a level, or an ultrasonic range down to the water.
-#[derive(Debug, Clone, Copy)]
-enum Reading {
-    Level(f64),
-    Range { range: f64, min: f64, max: f64 },
-}
-
-#[derive(Debug, Clone, Copy)]
-struct GaugeSample {
-    stamp_s: f64,
-    reading: Reading,
-}
-
-/// A gauge's accepted readings, oldest first, from the one in force at the last output on.
-#[derive(Debug, Clone, Default)]
-struct Readings(std::collections::VecDeque<(f64, f64)>);
-
-impl Readings {
-    fn push(&mut self, stamp_s: f64, level_m: f64) {
-        self.0.push_back((stamp_s, level_m));
-    }
-
-    /// The newest stamp heard, s.
-    fn newest(&self) -> Option<f64> {
-        self.0.back().map(|r| r.0)
-    }
-
-    /// The level in force at `t` (the last reading stamped at or before it), forgetting the
-    /// readings it supersedes: outputs come in time order.
-    fn at(&mut self, t: f64) -> Option<f64> {
-        while self.0.len() > 1 && self.0[1].0 <= t {
-            self.0.pop_front();
-        }
-        self.0.front().filter(|r| r.0 <= t).map(|r| r.1)
-    }
-}
-
 /// Runs the node until Ctrl-C (or `--until`).
 pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
-    let case = Case::from_path(&args.case).context("the case file was refused")?;
-    let Some(flume) = case.open_flume.clone() else {
+    let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
+    if case.open_flume.is_none() {
         bail!(
             "{}: the twin needs an open flume (open_flume: in the case) for its inflow to drive",
             args.case.display()
@@ -314,15 +279,7 @@ pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
         case.domain.max_m[vertical] - case.domain.min_m[vertical],
         &ros.parameters(&fqn)?,
     )?;
-    let derived = flume_solver::case::derive(&case);
-    let limits = Limits {
-        max_discharge_m3_per_s: flume_solver::flume::MAX_INLET_MACH
-            * derived.c0
-            * flume.inlet.height_m
-            * flume.width_m,
-        flume_height_m: case.domain.max_m[case.dim() - 1] - case.domain.min_m[case.dim() - 1],
-        future_tolerance_s: args.future_tolerance_s,
-    };
+    let limits = Limits::for_case(&case, args.future_tolerance_s);
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
@@ -380,57 +337,59 @@ async fn serve(
     let spinner = node.spinner().context("cannot spin the node")?;
     tokio::spawn(spinner.spin());
 
-    let inflow_sub = subscription::<Discharge>(&mut node, &ros, "inflow", reliable(10))?;
+    let inflow_sub =
+        subscription::<Discharge>(&mut node, &ros, topics::INFLOW, qos(topics::INFLOW_QOS))?;
     let mut level_subs = Vec::new();
     let mut range_subs = Vec::new();
     for g in &gauge_names {
-        let topic = format!("gauges/{}", g.to_lowercase());
+        let topic = topics::gauge(g);
         match args.gauge_msg {
             GaugeMsg::WaterLevel => level_subs.push(subscription::<WaterLevel>(
                 &mut node,
                 &ros,
                 &topic,
-                sensor_data(),
+                qos(topics::GAUGE_QOS),
             )?),
             GaugeMsg::Range => range_subs.push(subscription::<Range>(
                 &mut node,
                 &ros,
                 &topic,
-                sensor_data(),
+                qos(topics::GAUGE_QOS),
             )?),
         }
     }
     let bed_pub = publisher::<BedProfile>(
         &mut node,
         &ros,
-        "bed_profile",
-        reliable(1).durability(Durability::TransientLocal),
+        topics::BED_PROFILE,
+        qos(topics::LATCHED_QOS),
     )?;
-    let eroded_pub = publisher::<ErodedMass>(&mut node, &ros, "eroded_mass", reliable(10))?;
-    let compare_pub =
-        publisher::<GaugeComparison>(&mut node, &ros, "gauges/predicted", reliable(10))?;
-    let clock_pub = publisher::<Clock>(
+    let eroded_pub = publisher::<ErodedMass>(
         &mut node,
         &ros,
-        "/clock",
-        QosProfile::publisher_default()
-            .reliability_best_effort()
-            .history(History::KeepLast { depth: 1 }),
+        topics::ERODED_MASS,
+        qos(topics::OUTPUT_QOS),
     )?;
-    let diag_pub = publisher::<DiagnosticArray>(&mut node, &ros, "/diagnostics", reliable(10))?;
-    let cloud_pub = publisher::<PointCloud2>(
+    let compare_pub = publisher::<GaugeComparison>(
         &mut node,
         &ros,
-        "particles",
-        QosProfile::publisher_default()
-            .reliability_best_effort()
-            .history(History::KeepLast { depth: 1 }),
+        topics::GAUGE_COMPARISON,
+        qos(topics::OUTPUT_QOS),
     )?;
+    let clock_pub = publisher::<Clock>(&mut node, &ros, topics::CLOCK, qos(topics::STREAM_QOS))?;
+    let diag_pub = publisher::<DiagnosticArray>(
+        &mut node,
+        &ros,
+        topics::DIAGNOSTICS,
+        qos(topics::OUTPUT_QOS),
+    )?;
+    let cloud_pub =
+        publisher::<PointCloud2>(&mut node, &ros, topics::PARTICLES, qos(topics::STREAM_QOS))?;
     let marker_pub = publisher::<MarkerArray>(
         &mut node,
         &ros,
-        "bed_marker",
-        reliable(1).durability(Durability::TransientLocal),
+        topics::BED_MARKER,
+        qos(topics::LATCHED_QOS),
     )?;
     let mut last_cloud: Option<Instant> = None;
     let node_path = format!("{}/{node_name}", namespace.trim_end_matches('/'));
@@ -442,7 +401,7 @@ async fn serve(
     ]
     .iter()
     .map(|s| {
-        let qos = reliable(10);
+        let qos = qos(topics::OUTPUT_QOS);
         node.create_server::<TriggerRequest, TriggerResponse>(
             ServiceMapping::Enhanced,
             &Name::new(&node_path, s.name()).map_err(|e| anyhow!("service {}: {e}", s.name()))?,
@@ -810,63 +769,6 @@ impl Period {
     }
 }
 
-fn nan_if_none(v: Option<f64>) -> f64 {
-    v.unwrap_or(f64::NAN)
-}
-
-fn bed_profile(obs: &Observations, header: Header) -> BedProfile {
-    let bed = |f: fn(&flume_solver::observe::BedInterfaces) -> Option<f64>| -> Vec<f64> {
-        obs.profile
-            .iter()
-            .map(|c| nan_if_none(c.bed.as_ref().and_then(f)))
-            .collect()
-    };
-    BedProfile {
-        header,
-        x_m: obs.profile.iter().map(|c| c.x_m).collect(),
-        zb_m: bed(|b| b.zb_m),
-        zs_m: bed(|b| b.zs_m),
-        zw_m: bed(|b| b.zw_m),
-    }
-}
-
-fn eroded_mass(obs: &Observations, header: Header) -> Option<ErodedMass> {
-    obs.flume.as_ref().map(|f| ErodedMass {
-        header,
-        eroded_kg_per_m: f.eroded_kg_per_m,
-        eroded_kg: f.eroded_kg,
-        rate_kg_per_s: f.eroded_rate_kg_per_s,
-        particles: f.eroded_particles,
-    })
-}
-
-fn comparison(
-    obs: &Observations,
-    measured: &[Option<f64>],
-    stale: &[bool],
-    header: Header,
-) -> GaugeComparison {
-    GaugeComparison {
-        header,
-        gauges: obs
-            .gauges
-            .iter()
-            .zip(measured.iter().zip(stale))
-            .map(|(g, (m, &stale))| {
-                let predicted = nan_if_none(g.level_m);
-                let measured = nan_if_none(*m);
-                GaugeResidual {
-                    name: g.name.clone(),
-                    predicted_m: predicted,
-                    measured_m: measured,
-                    residual_m: predicted - measured,
-                    stale,
-                }
-            })
-            .collect(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -944,20 +846,5 @@ mod tests {
             .expect_err("refused");
             assert!(err.to_string().contains(reason), "{bad}: {err}");
         }
-    }
-
-    #[test]
-    fn a_gauge_is_compared_with_its_reading_at_the_output_time() {
-        let mut r = Readings::default();
-        assert_eq!(r.at(1.0), None, "no reading yet");
-        r.push(1.0, 0.07);
-        r.push(1.2, 0.08);
-        r.push(1.4, 0.09);
-        assert_eq!(r.at(0.5), None, "before the first reading");
-        assert_eq!(r.at(1.1), Some(0.07));
-        assert_eq!(r.at(1.3), Some(0.08));
-        assert_eq!(r.newest(), Some(1.4));
-        assert_eq!(r.at(2.0), Some(0.09));
-        assert_eq!(r.0.len(), 1, "superseded readings are forgotten");
     }
 }

@@ -16,7 +16,7 @@ const TICKS_PER_S: f64 = 1e6;
 
 pub fn run(args: &SimulateArgs) -> Result<()> {
     // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
-    let case = Case::from_path(&args.case).context("the case file was refused")?;
+    let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
     let end_s = match args.until {
         Some(t) if !(t.is_finite() && t > 0.0) => {
             bail!("--until must be a positive time in s, got {t}")

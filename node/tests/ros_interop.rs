@@ -5,10 +5,9 @@
 
 mod common;
 
-use common::{gpu, repo_file};
+use common::{csv_rows, gpu, repo_file};
 use serde_json::Value;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 fn have_cyclonedds() -> bool {
@@ -24,27 +23,6 @@ fn have_cyclonedds() -> bool {
         eprintln!("note: skipping the DDS interop test: pip install cyclonedds");
     }
     ok
-}
-
-/// Rows of a CSV file as maps from column to value.
-fn csv_rows(path: &PathBuf) -> Vec<BTreeMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .expect("a header")
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    lines
-        .map(|l| {
-            header
-                .iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect()
 }
 
 fn num(v: &Value) -> f64 {

@@ -298,3 +298,61 @@ fn an_open_flume_parks_its_reservoir_above_the_flow() {
         "count is an upper bound"
     );
 }
+
+#[test]
+fn overrides_change_a_case_and_are_validated_like_the_file() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+    let set = |o: &[&str]| {
+        Case::from_path_with(&path, &o.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+    };
+    let c = set(&[
+        "numerics.dp_m=0.01",
+        "open_flume.reservoir_particles=2500",
+        "phases.1.sediment.ks_over_d50=7",
+    ])
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(c.numerics.dp_m, 0.01);
+    assert_eq!(
+        c.open_flume.as_ref().map(|f| f.reservoir_particles),
+        Some(2500)
+    );
+    assert_eq!(
+        c.phases[1].sediment.as_ref().map(|s| s.ks_over_d50),
+        Some(7.0)
+    );
+    assert_eq!(
+        c.name,
+        launch_config("ulbra_flume.yaml").name,
+        "the rest is the file's"
+    );
+    for (bad, field, reason) in [
+        ("numerics.dp_m=-1", "numerics.dp_m", "positive"),
+        ("numerics.dpm=0.01", "numerics", "unknown field `dpm`"),
+        (
+            "phases.7.name=x",
+            "phases.7.name",
+            "index 7 past the list's 2 items",
+        ),
+        ("nowhere.dp_m=1", "nowhere.dp_m", "no section nowhere"),
+        ("numerics.dp_m", "numerics.dp_m", "key=value"),
+    ] {
+        match set(&[bad]) {
+            Err(ConfigError::Invalid {
+                field: f,
+                reason: r,
+                ..
+            })
+            | Err(ConfigError::Parse {
+                field: f,
+                reason: r,
+                ..
+            }) => {
+                assert!(
+                    f.starts_with(field) && r.contains(reason),
+                    "{bad}: {f}: {r}"
+                );
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+}

@@ -1,9 +1,13 @@
-//! What the binary's tests share: repository paths and the GPU gate.
+//! What the binary's tests share: repository paths, the GPU gate and the CSV reader.
 //!
 //! GPU tests skip with a note when no adapter is found, except under CI=true (CI has lavapipe),
 //! where a missing adapter is a failure. Within a test binary they run one at a time: lavapipe
 //! uses every core.
 
+// Each test binary compiles this module and uses part of it.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard};
 
@@ -26,4 +30,25 @@ pub fn gpu() -> Option<MutexGuard<'static, ()>> {
             None
         }
     }
+}
+
+/// Rows of a CSV file as maps from column to value.
+pub fn csv_rows(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .expect("a header")
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(str::to_string))
+                .collect()
+        })
+        .collect()
 }
