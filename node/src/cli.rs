@@ -80,6 +80,23 @@ pub struct RunArgs {
     /// Stop once simulated time reaches this, s (scripted runs and tests).
     #[arg(long, value_name = "T_S", value_parser = positive)]
     pub until: Option<f64>,
+    /// Record every input and output topic to this MCAP file (rosbag2's conventions).
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
+    /// With no sensor heard in --silent-wait-s, this recording's inflow and gauge topics play
+    /// the sensors (the path is relative to the working directory, the repository's root).
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "tests/data/ulbra_session.mcap"
+    )]
+    pub replay_when_silent: Option<PathBuf>,
+    /// Never play a recording in the sensors' place: with no sensors, run on the clock.
+    #[arg(long)]
+    pub no_replay: bool,
+    /// How long to wait for a sensor before the recording plays, s.
+    #[arg(long, value_name = "S", default_value_t = 3.0, value_parser = positive)]
+    pub silent_wait_s: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

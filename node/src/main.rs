@@ -14,10 +14,12 @@ mod pacer;
 mod replay;
 mod ros_args;
 mod run;
+mod samples;
 mod session;
 mod simulate;
 mod solver_thread;
 mod table;
+mod tap;
 mod topics;
 mod visual;
 

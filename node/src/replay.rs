@@ -8,92 +8,22 @@
 use crate::bag::writer::Channel as BagChannel;
 use crate::bag::{BagWriter, Recorded, Recording};
 use crate::cli::ReplayArgs;
-use crate::inputs::{self, GaugeSample, InputGate, Reading, Readings};
+use crate::inputs::{self, InputGate, Reading, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
+use crate::samples::{Input, decode, role};
 use crate::solver_thread::{self, Command};
 use crate::topics;
 use crate::visual;
 use anyhow::{Context, Result, anyhow, bail};
 use flume_msgs::RosMessage;
 use flume_msgs::builtin_interfaces::Time;
-use flume_msgs::flume_msgs::{BedProfile, Discharge, ErodedMass, GaugeComparison, WaterLevel};
+use flume_msgs::flume_msgs::{BedProfile, Discharge, ErodedMass, GaugeComparison};
 use flume_msgs::rosgraph_msgs::Clock;
-use flume_msgs::sensor_msgs::Range;
 use flume_msgs::std_msgs::Header;
 use flume_msgs::visualization_msgs::MarkerArray;
 use flume_solver::Case;
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
-
-/// A sensor sample from a recording.
-#[derive(Debug, Clone, Copy)]
-pub enum Input {
-    Inflow { stamp_s: f64, q: f64 },
-    Gauge { index: usize, sample: GaugeSample },
-}
-
-impl Input {
-    pub fn stamp_s(&self) -> f64 {
-        match self {
-            Input::Inflow { stamp_s, .. } => *stamp_s,
-            Input::Gauge { sample, .. } => sample.stamp_s,
-        }
-    }
-}
-
-/// What a recorded topic is to the twin: the inflow, gauge `k`, or nothing. A topic matches
-/// by its last segments (`.../inflow`, `.../gauges/p1`) whatever namespace it was recorded in,
-/// and by its type.
-pub fn role(msg: &Recorded, gauges: &[String]) -> Option<Option<usize>> {
-    let ends =
-        |name: &str| msg.topic == format!("/{name}") || msg.topic.ends_with(&format!("/{name}"));
-    if msg.schema_name == Discharge::DEF.schema_name() && ends(topics::INFLOW) {
-        return Some(None);
-    }
-    let gauge_type = msg.schema_name == WaterLevel::DEF.schema_name()
-        || msg.schema_name == Range::DEF.schema_name();
-    gauges
-        .iter()
-        .position(|g| gauge_type && ends(&topics::gauge(g)))
-        .map(Some)
-}
-
-/// Decodes a recorded sample of the role `role` (see [`role`]).
-pub fn decode(msg: &Recorded, role: Option<usize>) -> Result<Input> {
-    Ok(match role {
-        None => {
-            let m: Discharge = msg.decode()?;
-            Input::Inflow {
-                stamp_s: m.header.stamp.as_secs_f64(),
-                q: m.discharge_m3_per_s,
-            }
-        }
-        Some(index) if msg.schema_name == Range::DEF.schema_name() => {
-            let m: Range = msg.decode()?;
-            Input::Gauge {
-                index,
-                sample: GaugeSample {
-                    stamp_s: m.header.stamp.as_secs_f64(),
-                    reading: Reading::Range {
-                        range: f64::from(m.range),
-                        min: f64::from(m.min_range),
-                        max: f64::from(m.max_range),
-                    },
-                },
-            }
-        }
-        Some(index) => {
-            let m: WaterLevel = msg.decode()?;
-            Input::Gauge {
-                index,
-                sample: GaugeSample {
-                    stamp_s: m.header.stamp.as_secs_f64(),
-                    reading: Reading::Level(m.level_m),
-                },
-            }
-        }
-    })
-}
 
 /// The output recording's channels.
 struct Outputs {
@@ -228,7 +158,7 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
     let mut carried: Option<(usize, f64)> = None;
     for (k, (m, r)) in feed.iter().enumerate() {
         let input = match decode(m, *r) {
-            Ok(i) => i,
+            Ok(sample) => sample.input(),
             Err(e) => {
                 undecodable += 1;
                 log::warn!("{e:#}");

@@ -5,13 +5,16 @@
 //! out as the bed profile, the eroded mass, the gauge comparison, `/clock` and, once a
 //! second, `/diagnostics`. This module knows topics and times, not SPH.
 
+use crate::bag::Recording;
 use crate::bag::TopicQos;
 use crate::cli::{GaugeMsg, RunArgs};
-use crate::inputs::{GaugeSample, InputGate, Limits, Reading, Readings};
+use crate::inputs::{InputGate, Limits, Reading, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
 use crate::pacer::Pacer;
 use crate::ros_args::{ParamValue, RosArgs};
+use crate::samples::{Input, Sample, decode, role};
 use crate::solver_thread::{self, Command, Report};
+use crate::tap::{Outlet, Tap, input_channels};
 use crate::topics;
 use crate::visual;
 use anyhow::{Context as _, Result, anyhow, bail};
@@ -29,17 +32,19 @@ use futures::StreamExt;
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{
-    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, ParameterValue, Publisher,
-    QosProfile, ServiceMapping, ServiceTypeName, Subscription,
+    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, ParameterValue, QosProfile,
+    ServiceMapping, ServiceTypeName, Subscription,
 };
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use std::net::Ipv4Addr;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 /// The node's clock: ROS time, seconds since the epoch.
-fn now_s() -> f64 {
+pub fn now_s() -> f64 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64())
@@ -70,17 +75,35 @@ fn topic_name(ros: &RosArgs, name: &str) -> Result<Name> {
     Name::parse(&remapped).map_err(|e| anyhow!("topic {remapped:?}: {e}"))
 }
 
-fn publisher<M: RosMessage + Serialize>(
+/// A topic's full name after the remaps, as a recording names it.
+fn full_topic(namespace: &str, ros: &RosArgs, name: &str) -> String {
+    let remapped = ros.remap(name);
+    if remapped.starts_with('/') {
+        remapped
+    } else {
+        format!("{}/{remapped}", namespace.trim_end_matches('/'))
+    }
+}
+
+/// A publisher of `M` on `name`, recorded when the node records.
+fn outlet<M: RosMessage + Serialize>(
     node: &mut Node,
     ros: &RosArgs,
+    recorder: &mut Tap,
+    full: &dyn Fn(&str) -> String,
     name: &str,
-    qos: QosProfile,
-) -> Result<Publisher<M>> {
+    topic_qos: TopicQos,
+) -> Result<Outlet<M>> {
+    let q = qos(topic_qos);
     let topic = node
-        .create_topic(&topic_name(ros, name)?, type_name(M::DEF), &qos)
+        .create_topic(&topic_name(ros, name)?, type_name(M::DEF), &q)
         .with_context(|| format!("cannot create topic {name}"))?;
-    node.create_publisher::<M>(&topic, Some(qos))
-        .with_context(|| format!("cannot publish {name}"))
+    Ok(Outlet {
+        publisher: node
+            .create_publisher::<M>(&topic, Some(q))
+            .with_context(|| format!("cannot publish {name}"))?,
+        channel: recorder.channel::<M>(&full(name), topic_qos)?,
+    })
 }
 
 fn subscription<M: RosMessage + DeserializeOwned + 'static>(
@@ -358,38 +381,75 @@ async fn serve(
             )?),
         }
     }
-    let bed_pub = publisher::<BedProfile>(
+    let mut recorder = Tap::create(args.record.as_deref())?;
+    let full = |name: &str| full_topic(&namespace, &ros, name);
+    let inputs = input_channels(
+        &mut recorder,
+        &full(topics::INFLOW),
+        &gauge_names
+            .iter()
+            .map(|g| full(&topics::gauge(g)))
+            .collect::<Vec<_>>(),
+        args.gauge_msg == GaugeMsg::Range,
+        topics::INFLOW_QOS,
+        topics::GAUGE_QOS,
+    )?;
+    recorder.set_inputs(inputs);
+    let bed_out = outlet::<BedProfile>(
         &mut node,
         &ros,
+        &mut recorder,
+        &full,
         topics::BED_PROFILE,
-        qos(topics::LATCHED_QOS),
+        topics::LATCHED_QOS,
     )?;
-    let eroded_pub = publisher::<ErodedMass>(
+    let eroded_out = outlet::<ErodedMass>(
         &mut node,
         &ros,
+        &mut recorder,
+        &full,
         topics::ERODED_MASS,
-        qos(topics::OUTPUT_QOS),
+        topics::OUTPUT_QOS,
     )?;
-    let compare_pub = publisher::<GaugeComparison>(
+    let compare_out = outlet::<GaugeComparison>(
         &mut node,
         &ros,
+        &mut recorder,
+        &full,
         topics::GAUGE_COMPARISON,
-        qos(topics::OUTPUT_QOS),
+        topics::OUTPUT_QOS,
     )?;
-    let clock_pub = publisher::<Clock>(&mut node, &ros, topics::CLOCK, qos(topics::STREAM_QOS))?;
-    let diag_pub = publisher::<DiagnosticArray>(
+    let clock_out = outlet::<Clock>(
         &mut node,
         &ros,
+        &mut recorder,
+        &full,
+        topics::CLOCK,
+        topics::STREAM_QOS,
+    )?;
+    let diag_out = outlet::<DiagnosticArray>(
+        &mut node,
+        &ros,
+        &mut recorder,
+        &full,
         topics::DIAGNOSTICS,
-        qos(topics::OUTPUT_QOS),
+        topics::OUTPUT_QOS,
     )?;
-    let cloud_pub =
-        publisher::<PointCloud2>(&mut node, &ros, topics::PARTICLES, qos(topics::STREAM_QOS))?;
-    let marker_pub = publisher::<MarkerArray>(
+    let cloud_out = outlet::<PointCloud2>(
         &mut node,
         &ros,
+        &mut recorder,
+        &full,
+        topics::PARTICLES,
+        topics::STREAM_QOS,
+    )?;
+    let marker_out = outlet::<MarkerArray>(
+        &mut node,
+        &ros,
+        &mut recorder,
+        &full,
         topics::BED_MARKER,
-        qos(topics::LATCHED_QOS),
+        topics::LATCHED_QOS,
     )?;
     let mut last_cloud: Option<Instant> = None;
     let node_path = format!("{}/{node_name}", namespace.trim_end_matches('/'));
@@ -423,42 +483,68 @@ async fn serve(
             Box::pin(srv.receive_request_stream().map(move |r| (which, r)))
         }));
 
-    let mut inflow_stream = Box::pin(inflow_sub.async_stream());
-    type GaugeStream<'a> = std::pin::Pin<
-        Box<dyn futures::Stream<Item = (usize, Result<GaugeSample, String>)> + Send + 'a>,
+    // Every sensor topic as one stream of (topic, sample or why it could not be read).
+    type SensorStream<'a> = std::pin::Pin<
+        Box<dyn futures::Stream<Item = (String, Result<Sample, String>)> + Send + 'a>,
     >;
-    let streams: Vec<GaugeStream> = level_subs
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            Box::pin(s.async_stream().map(move |r| {
-                let sample = r.map(|(m, _)| GaugeSample {
-                    stamp_s: m.header.stamp.as_secs_f64(),
-                    reading: Reading::Level(m.level_m),
-                });
-                (i, sample.map_err(|e| format!("{e:?}")))
-            })) as GaugeStream
-        })
-        .chain(range_subs.iter().enumerate().map(|(i, s)| {
-            Box::pin(s.async_stream().map(move |r| {
-                let sample = r.map(|(m, _)| GaugeSample {
-                    stamp_s: m.header.stamp.as_secs_f64(),
-                    reading: Reading::Range {
-                        range: f64::from(m.range),
-                        min: f64::from(m.min_range),
-                        max: f64::from(m.max_range),
-                    },
-                });
-                (i, sample.map_err(|e| format!("{e:?}")))
-            })) as GaugeStream
-        }))
-        .collect();
-    let mut gauge_stream = futures::stream::select_all(streams);
+    let error = |e: ros2_client::ReadError| format!("{e:?}");
+    let mut streams: Vec<SensorStream> = vec![Box::pin(inflow_sub.async_stream().map(move |r| {
+        (
+            "inflow".to_string(),
+            r.map(|(m, _)| Sample::Inflow(m)).map_err(error),
+        )
+    }))];
+    for (i, s) in level_subs.iter().enumerate() {
+        let name = gauge_names[i].clone();
+        streams.push(Box::pin(s.async_stream().map(move |r| {
+            (
+                name.clone(),
+                r.map(|(m, _)| Sample::Level(i, m)).map_err(error),
+            )
+        })));
+    }
+    for (i, s) in range_subs.iter().enumerate() {
+        let name = gauge_names[i].clone();
+        streams.push(Box::pin(s.async_stream().map(move |r| {
+            (
+                name.clone(),
+                r.map(|(m, _)| Sample::Range(i, m)).map_err(error),
+            )
+        })));
+    }
+    let mut sensor_stream = futures::stream::select_all(streams);
+    // With no sensor on the network, a recorded session plays the sensors' part.
+    let heard_sensor = Arc::new(AtomicBool::new(false));
+    let (fallback_tx, mut fallback_rx) = tokio::sync::mpsc::channel::<Sample>(64);
+    let fallback = args
+        .replay_when_silent
+        .clone()
+        .filter(|_| !args.no_replay)
+        .filter(|path| {
+            let exists = path.exists();
+            if !exists {
+                log::warn!(
+                    "{} does not exist: with no sensors the twin runs on the clock",
+                    path.display()
+                );
+            }
+            exists
+        });
+    let wait_for_sensors = args.wait_for_sensors || fallback.is_some();
+    if let Some(path) = fallback {
+        tokio::spawn(play_when_silent(
+            path,
+            gauge_names.clone(),
+            Duration::from_secs_f64(args.silent_wait_s),
+            Arc::clone(&heard_sensor),
+            fallback_tx,
+        ));
+    }
     let mut gate = InputGate::new(limits);
     let mut pacer = Pacer::new(
         settings.target_rtf,
         settings.stale_after_s,
-        args.wait_for_sensors,
+        wait_for_sensors,
     );
     let mut measured: Vec<Readings> = vec![Readings::default(); gauge_names.len()];
     let mut sim_t = 0.0;
@@ -476,52 +562,42 @@ async fn serve(
     let mut diag_tick = tokio::time::interval(Duration::from_secs(1));
     let until = args.until;
     let mut shutdown = Box::pin(tokio::signal::ctrl_c());
+    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+        .context("cannot watch for SIGTERM")?;
     loop {
         tokio::select! {
             _ = &mut shutdown => {
                 println!("interrupted at t = {sim_t:.3} s");
                 break;
             }
-            Some(r) = inflow_stream.next() => match r {
-                Ok((msg, _)) => {
-                    let stamp = msg.header.stamp.as_secs_f64();
-                    if gate.discharge("inflow", stamp, msg.discharge_m3_per_s, now_s()).is_ok() {
-                        pacer.inflow(stamp, msg.discharge_m3_per_s);
-                    }
-                }
-                Err(e) => {
-                    undecodable += 1;
-                    log::warn!("inflow: a sample could not be read: {e:?}");
-                }
-            },
-            Some((g, r)) = gauge_stream.next() => match r {
+            _ = terminate.recv() => {
+                println!("terminated at t = {sim_t:.3} s");
+                break;
+            }
+            Some((topic, r)) = sensor_stream.next() => match r {
                 Ok(sample) => {
-                    let stamp = sample.stamp_s;
-                    let name = &gauge_names[g];
-                    let level = match sample.reading {
-                        Reading::Level(level) => gate.level(name, stamp, level, now_s()).map(|()| level),
-                        Reading::Range { range, min, max } => {
-                            let mount = settings.mount_height_m[g];
-                            gate.range(name, stamp, range, (min, max), mount, now_s())
-                        }
-                    };
-                    if let Ok(level) = level {
-                        pacer.heard(stamp);
-                        measured[g].push(stamp, level);
+                    if !heard_sensor.swap(true, Ordering::Relaxed) {
+                        println!("sensors heard on {topic}");
                     }
+                    recorder.input(&sample);
+                    take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now_s());
                 }
                 Err(e) => {
                     undecodable += 1;
-                    log::warn!("gauge {}: a sample could not be read: {e:?}", gauge_names[g]);
+                    log::warn!("{topic}: a sample could not be read: {e}");
                 }
             },
+            Some(sample) = fallback_rx.recv() => {
+                recorder.input(&sample);
+                take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now_s());
+            }
             Some(report) = reports.recv() => {
                 outstanding = outstanding.saturating_sub(1);
                 let report: Report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
                 sim_t = report.obs.time_s;
                 if report.reset {
                     // A new start: t = 0 is the next event; queued inputs belonged to the old run.
-                    pacer = Pacer::new(pacer.target_rtf, pacer.stale_after_s, args.wait_for_sensors);
+                    pacer = Pacer::new(pacer.target_rtf, pacer.stale_after_s, wait_for_sensors);
                     measured = vec![Readings::default(); gauge_names.len()];
                     println!("reset to the case's initial state");
                 }
@@ -530,10 +606,10 @@ async fn serve(
                 let origin = pacer.origin().unwrap_or_else(now_s);
                 let stamp = Time::from_secs_f64(origin + sim_t).unwrap_or_default();
                 let header = Header { stamp, frame_id: settings.frame_id.clone() };
-                publish(&clock_pub, Clock { clock: stamp }).await;
+                clock_out.send(&mut recorder, Clock { clock: stamp }).await;
                 if let Some(points) = &report.cloud {
                     let cloud = visual::point_cloud(header.clone(), points, args.cloud_max_points);
-                    publish(&cloud_pub, cloud).await;
+                    cloud_out.send(&mut recorder, cloud).await;
                 }
                 // Outputs are decimated to the publish rate when the solver reports faster;
                 // inputs never are.
@@ -552,16 +628,16 @@ async fn serve(
                     let at: Vec<Option<f64>> =
                         measured.iter_mut().map(|m| m.at(origin + sim_t)).collect();
                     let bed = bed_profile(&report.obs, header.clone());
-                    publish(
-                        &marker_pub,
+                    marker_out.send(
+                        &mut recorder,
                         visual::bed_lines(&header, &bed.x_m, &bed.zs_m, &bed.zw_m),
                     )
                     .await;
-                    publish(&bed_pub, bed).await;
+                    bed_out.send(&mut recorder, bed).await;
                     if let Some(msg) = eroded_mass(&report.obs, header.clone()) {
-                        publish(&eroded_pub, msg).await;
+                        eroded_out.send(&mut recorder, msg).await;
                     }
-                    publish(&compare_pub, comparison(&report.obs, &at, &stale, header)).await;
+                    compare_out.send(&mut recorder, comparison(&report.obs, &at, &stale, header)).await;
                 } else {
                     decimated_outputs += 1;
                 }
@@ -681,7 +757,7 @@ async fn serve(
                     (false, true) => "running".to_string(),
                 };
                 let stamp = Time::from_secs_f64(now).unwrap_or_default();
-                publish(&diag_pub, DiagnosticArray {
+                diag_out.send(&mut recorder, DiagnosticArray {
                     header: Header { stamp, frame_id: String::new() },
                     status: vec![DiagnosticStatus {
                         level,
@@ -698,6 +774,7 @@ async fn serve(
         }
     }
     drop(commands);
+    recorder.finish()?;
     // The solver finishes its chunk and sees the closed channel.
     if handle.join().is_err() {
         log::warn!("the solver thread panicked");
@@ -705,10 +782,117 @@ async fn serve(
     Ok(())
 }
 
-async fn publish<M: Serialize + std::fmt::Debug>(publisher: &Publisher<M>, msg: M) {
-    if let Err(e) = publisher.async_publish(msg).await {
-        log::warn!("a message could not be published: {e:?}");
+/// Gates a sensor sample; what passes goes to the pacer and to the gauge's readings.
+fn take(
+    input: Input,
+    gate: &mut InputGate,
+    pacer: &mut Pacer,
+    measured: &mut [Readings],
+    gauge_names: &[String],
+    mount_height_m: &[f64],
+    now: f64,
+) {
+    match input {
+        Input::Inflow { stamp_s, q } => {
+            if gate.discharge("inflow", stamp_s, q, now).is_ok() {
+                pacer.inflow(stamp_s, q);
+            }
+        }
+        Input::Gauge { index, sample } => {
+            let name = &gauge_names[index];
+            let stamp = sample.stamp_s;
+            let level = match sample.reading {
+                Reading::Level(level) => gate.level(name, stamp, level, now).map(|()| level),
+                Reading::Range { range, min, max } => {
+                    gate.range(name, stamp, range, (min, max), mount_height_m[index], now)
+                }
+            };
+            if let Ok(level) = level {
+                pacer.heard(stamp);
+                measured[index].push(stamp, level);
+            }
+        }
     }
+}
+
+/// With no sensor heard for `wait`, plays the inflow and gauge topics of the recording at
+/// `path` as the sensors, at their recorded pace, restamped on this node's clock; stops at
+/// the first sample a real sensor sends.
+async fn play_when_silent(
+    path: PathBuf,
+    gauges: Vec<String>,
+    wait: Duration,
+    heard: Arc<AtomicBool>,
+    to_twin: tokio::sync::mpsc::Sender<Sample>,
+) {
+    tokio::time::sleep(wait).await;
+    if heard.load(Ordering::Relaxed) {
+        return;
+    }
+    let read = tokio::task::spawn_blocking({
+        let path = path.clone();
+        move || Recording::read(&path)
+    })
+    .await;
+    let recording = match read {
+        Ok(Ok(r)) => r,
+        Ok(Err(e)) => {
+            log::error!("no sensors, and the session to replay cannot be read: {e:#}");
+            return;
+        }
+        Err(e) => {
+            log::error!("no sensors, and reading the session to replay failed: {e}");
+            return;
+        }
+    };
+    if let Some(damage) = &recording.damage {
+        log::warn!("{damage}; replaying what comes before it");
+    }
+    let mut samples: Vec<(u64, Sample)> = recording
+        .messages
+        .iter()
+        .filter_map(|m| role(m, &gauges).map(|r| (m, r)))
+        .filter_map(|(m, r)| match decode(m, r) {
+            Ok(s) => Some((m.log_ns, s)),
+            Err(e) => {
+                log::warn!("{e:#}");
+                None
+            }
+        })
+        .collect();
+    samples.sort_by_key(|(log_ns, _)| *log_ns);
+    let Some(first) = samples.first().map(|(_, s)| s.stamp().as_secs_f64()) else {
+        log::warn!(
+            "{} has no sensor topic of this case to replay",
+            path.display()
+        );
+        return;
+    };
+    let span = samples.last().map_or(0.0, |(_, s)| s.stamp().as_secs_f64()) - first;
+    println!(
+        "no sensors in {:.0} s: {} plays the sensors ({} samples over {span:.0} s)",
+        wait.as_secs_f64(),
+        path.display(),
+        samples.len()
+    );
+    let start = now_s();
+    let started = Instant::now();
+    for (_, mut sample) in samples {
+        let offset = sample.stamp().as_secs_f64() - first;
+        if let Some(rest) = Duration::from_secs_f64(offset.max(0.0)).checked_sub(started.elapsed())
+        {
+            tokio::time::sleep(rest).await;
+        }
+        if heard.load(Ordering::Relaxed) {
+            println!("a sensor spoke: the recorded session stops");
+            return;
+        }
+        sample.set_stamp(Time::from_secs_f64(start + offset).unwrap_or_default());
+        if to_twin.send(sample).await.is_err() {
+            return;
+        }
+    }
+    println!("the recorded session has ended: the twin holds its last discharge");
 }
 
 /// The twin's services (std_srvs/Trigger), under the node's name; the order is that of the

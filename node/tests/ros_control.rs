@@ -121,6 +121,7 @@ fn parameters_and_services_from_another_process_control_the_twin() {
                     .to_str()
                     .expect("utf-8"),
                 "--loopback",
+                "--no-replay",
                 "--wait-for-sensors",
                 "--gauge-msg",
                 "range",

@@ -47,6 +47,7 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
                 .to_str()
                 .expect("utf-8"),
             "--loopback",
+            "--no-replay",
             "--wait-for-sensors",
             "--until",
             "0.5",

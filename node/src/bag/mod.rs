@@ -89,7 +89,10 @@ mod tests {
         std::fs::write(&cut, &bytes[..bytes.len() / 2]).expect("writes");
         let r = Recording::read(&cut).expect("a cut file is no error");
         let n = r.messages.len();
-        assert!((30..100).contains(&n) && n.is_multiple_of(10), "whole chunks only: {n}");
+        assert!(
+            (30..100).contains(&n) && n.is_multiple_of(10),
+            "whole chunks only: {n}"
+        );
         assert_eq!(
             levels(&r),
             (0..n).map(|k| k as f64 * 1e-3).collect::<Vec<_>>()

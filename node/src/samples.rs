@@ -1,0 +1,107 @@
+//! Sensor samples as the twin takes them, from the wire or from a recording: the message as it
+//! came (so it can be recorded), and what the input gate needs from it.
+
+use crate::bag::Recorded;
+use crate::inputs::{GaugeSample, Reading};
+use crate::topics;
+use anyhow::Result;
+use flume_msgs::RosMessage;
+use flume_msgs::builtin_interfaces::Time;
+use flume_msgs::flume_msgs::{Discharge, WaterLevel};
+use flume_msgs::sensor_msgs::Range;
+
+/// A sample of the inflow, or of gauge `k` (the case's k-th gauge).
+#[derive(Debug, Clone)]
+pub enum Sample {
+    Inflow(Discharge),
+    Level(usize, WaterLevel),
+    Range(usize, Range),
+}
+
+/// What the gate and the pacer take from a sample.
+#[derive(Debug, Clone, Copy)]
+pub enum Input {
+    Inflow { stamp_s: f64, q: f64 },
+    Gauge { index: usize, sample: GaugeSample },
+}
+
+impl Input {
+    pub fn stamp_s(&self) -> f64 {
+        match self {
+            Input::Inflow { stamp_s, .. } => *stamp_s,
+            Input::Gauge { sample, .. } => sample.stamp_s,
+        }
+    }
+}
+
+impl Sample {
+    pub fn stamp(&self) -> Time {
+        match self {
+            Sample::Inflow(m) => m.header.stamp,
+            Sample::Level(_, m) => m.header.stamp,
+            Sample::Range(_, m) => m.header.stamp,
+        }
+    }
+
+    pub fn set_stamp(&mut self, stamp: Time) {
+        match self {
+            Sample::Inflow(m) => m.header.stamp = stamp,
+            Sample::Level(_, m) => m.header.stamp = stamp,
+            Sample::Range(_, m) => m.header.stamp = stamp,
+        }
+    }
+
+    pub fn input(&self) -> Input {
+        let stamp_s = self.stamp().as_secs_f64();
+        match self {
+            Sample::Inflow(m) => Input::Inflow {
+                stamp_s,
+                q: m.discharge_m3_per_s,
+            },
+            Sample::Level(index, m) => Input::Gauge {
+                index: *index,
+                sample: GaugeSample {
+                    stamp_s,
+                    reading: Reading::Level(m.level_m),
+                },
+            },
+            Sample::Range(index, m) => Input::Gauge {
+                index: *index,
+                sample: GaugeSample {
+                    stamp_s,
+                    reading: Reading::Range {
+                        range: f64::from(m.range),
+                        min: f64::from(m.min_range),
+                        max: f64::from(m.max_range),
+                    },
+                },
+            },
+        }
+    }
+}
+
+/// What a recorded topic is to the twin: the inflow (`Some(None)`), gauge `k`
+/// (`Some(Some(k))`), or nothing. A topic matches by its last segments (`.../inflow`,
+/// `.../gauges/p1`) whatever namespace it was recorded in, and by its type.
+pub fn role(msg: &Recorded, gauges: &[String]) -> Option<Option<usize>> {
+    let ends =
+        |name: &str| msg.topic == format!("/{name}") || msg.topic.ends_with(&format!("/{name}"));
+    if msg.schema_name == Discharge::DEF.schema_name() && ends(topics::INFLOW) {
+        return Some(None);
+    }
+    let gauge_type = msg.schema_name == WaterLevel::DEF.schema_name()
+        || msg.schema_name == Range::DEF.schema_name();
+    gauges
+        .iter()
+        .position(|g| gauge_type && ends(&topics::gauge(g)))
+        .map(Some)
+}
+
+/// Decodes a recorded sample of the role `role` (see [`role`]).
+pub fn decode(msg: &Recorded, role: Option<usize>) -> Result<Sample> {
+    Ok(match role {
+        None => Sample::Inflow(msg.decode()?),
+        Some(k) if msg.schema_name == Range::DEF.schema_name() => Sample::Range(k, msg.decode()?),
+        Some(k) => Sample::Level(k, msg.decode()?),
+    })
+}
