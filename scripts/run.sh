@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# Builds and runs flume-twin with the given arguments (default: the dam-break verification case).
-# Installs what it needs first. Example: scripts/run.sh simulate launch_configs/dambreak_water.yaml
+# Builds and runs flume-twin with the given arguments. Installs what it needs first.
+# Default: the twin of the ULBRA flume at CI size (dp = 1 cm, which a software adapter runs at a
+# few percent of real time); with no sensors on the network the bundled session plays them.
+# Example: scripts/run.sh simulate launch_configs/dambreak_water.yaml
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
 if [ "$#" -eq 0 ]; then
-  set -- simulate launch_configs/dambreak_water.yaml
+  set -- run launch_configs/ulbra_flume.yaml --set numerics.dp_m=0.01 \
+    --set open_flume.reservoir_particles=2500
 fi
 cargo run --release --quiet --bin flume-twin -- "$@"

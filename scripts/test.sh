@@ -4,8 +4,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
-# Independent readers: meshio for our VTK snapshots (node/tests/cli.rs), mcap-ros2-support's
-# ROS 2 decoder for our CDR messages (msgs/tests/cdr_interop.rs).
+# Independent readers: meshio for our VTK snapshots (node/tests/cli.rs), Python's mcap and
+# mcap-ros2-support for our CDR messages and recordings (msgs/tests/cdr_interop.rs,
+# node/tests/replay.rs, node/tests/record.rs).
 if ! python3 -c "import meshio" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check meshio
 fi

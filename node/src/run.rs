@@ -560,6 +560,7 @@ async fn serve(
     let mut period = Period::new(sim_t);
     let mut tick = tokio::time::interval(Duration::from_millis(20));
     let mut diag_tick = tokio::time::interval(Duration::from_secs(1));
+    let mut diag_count = 0u64;
     let until = args.until;
     let mut shutdown = Box::pin(tokio::signal::ctrl_c());
     let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
@@ -722,6 +723,20 @@ async fn serve(
                     .collect();
                 let lag = pacer.lag(sim_t, now);
                 let (rtf, step_rate, busy) = period.take(sim_t);
+                diag_count += 1;
+                // A line on the terminal every ten seconds, for whoever started the twin by hand.
+                if diag_count % 10 == 0 {
+                    let levels: Vec<String> = gauge_names
+                        .iter()
+                        .zip(&last_obs.gauges)
+                        .map(|(n, g)| format!("{n} {}", g.level_m.map_or("dry".into(), |l| format!("{l:.4} m"))))
+                        .collect();
+                    let eroded = last_obs.flume.as_ref().map_or(0.0, |f| f.eroded_kg);
+                    println!(
+                        "t = {sim_t:.2} s, {rtf:.3} x real time, {lag:.1} s behind; {}; eroded {eroded:.4} kg",
+                        levels.join(", ")
+                    );
+                }
                 let mut values = vec![
                     ("sim_time_s", format!("{sim_t:.6}")),
                     ("real_time_factor", format!("{rtf:.4}")),
