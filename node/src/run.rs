@@ -725,7 +725,7 @@ async fn serve(
                 let (rtf, step_rate, busy) = period.take(sim_t);
                 diag_count += 1;
                 // A line on the terminal every ten seconds, for whoever started the twin by hand.
-                if diag_count % 10 == 0 {
+                if diag_count.is_multiple_of(10) {
                     let levels: Vec<String> = gauge_names
                         .iter()
                         .zip(&last_obs.gauges)
