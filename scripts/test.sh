@@ -17,4 +17,12 @@ fi
 if ! python3 -c "import cyclonedds" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check cyclonedds
 fi
+# iceoryx2's own Python binding, the reader of our particle frames, and the rerun SDK of the
+# reference visualiser (node/tests/frames.rs).
+if ! python3 -c "import iceoryx2" >/dev/null 2>&1; then
+  python3 -m pip install --quiet --disable-pip-version-check iceoryx2==0.10.0
+fi
+if ! python3 -c "import rerun" >/dev/null 2>&1; then
+  python3 -m pip install --quiet --disable-pip-version-check rerun-sdk==0.41.0
+fi
 cargo test --release --workspace "$@"

@@ -6,6 +6,7 @@
 mod bag;
 mod bench;
 mod cli;
+mod frames;
 mod inflow;
 mod inputs;
 mod observed;

@@ -225,7 +225,7 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
         particles,
         first,
         handle,
-    } = solver_thread::spawn(case, args.csv.clone())?;
+    } = solver_thread::spawn(case, args.csv.clone(), None)?;
     println!("adapter: {adapter}\nparticles: {particles}");
     let mut out = args.out.as_deref().map(Outputs::create).transpose()?;
     let compare_at = |measured: &mut [Readings], t: f64| {

@@ -335,7 +335,14 @@ async fn serve(
         particles,
         first,
         handle,
-    } = solver_thread::spawn(case, args.out.clone())?;
+    } = solver_thread::spawn(
+        case,
+        args.out.clone(),
+        (!args.no_frames).then(|| solver_thread::FrameSettings {
+            service: args.frames_service.clone(),
+            rate_hz: args.frames_rate_hz,
+        }),
+    )?;
     println!("adapter: {adapter}\nparticles: {particles}\nnode: {namespace} {node_name}");
 
     let live = Arc::new(Mutex::new(settings.clone()));
@@ -553,6 +560,7 @@ async fn serve(
     let mut paused = false;
     let mut undecodable = 0u64;
     let mut solver_refused = 0u64;
+    let (mut frames_sent, mut frames_skipped) = (0u64, 0u64);
     let mut published_outputs = 0u64;
     let mut decimated_outputs = 0u64;
     let mut last_publish: Option<Instant> = None;
@@ -603,6 +611,7 @@ async fn serve(
                     println!("reset to the case's initial state");
                 }
                 solver_refused += report.refused_inflows;
+                (frames_sent, frames_skipped) = (report.frames_sent, report.frames_skipped);
                 period.add(&report);
                 let origin = pacer.origin().unwrap_or_else(now_s);
                 let stamp = Time::from_secs_f64(origin + sim_t).unwrap_or_default();
@@ -756,6 +765,8 @@ async fn serve(
                     ("published_outputs", published_outputs.to_string()),
                     ("decimated_outputs", decimated_outputs.to_string()),
                     ("recoveries", last_obs.recoveries.to_string()),
+                    ("particle_frames_sent", frames_sent.to_string()),
+                    ("particle_frames_skipped", frames_skipped.to_string()),
                 ];
                 for (k, n) in gate.refused() {
                     values.push((k, n.to_string()));

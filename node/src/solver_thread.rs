@@ -1,6 +1,7 @@
 //! The solver on a thread of its own: GPU work never blocks the async runtime. The node sends
 //! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
 
+use crate::frames::Frames;
 use crate::output::recorder::Recorder;
 use crate::visual::CloudPoint;
 use anyhow::{Context, Result};
@@ -38,6 +39,16 @@ pub struct Report {
     pub cloud: Option<Vec<CloudPoint>>,
     /// This report is the initial state after a reset.
     pub reset: bool,
+    /// Particle frames sent to visualisers and skipped, since the start.
+    pub frames_sent: u64,
+    pub frames_skipped: u64,
+}
+
+/// Where and how often the solver thread offers particle frames (iceoryx2).
+#[derive(Debug, Clone)]
+pub struct FrameSettings {
+    pub service: String,
+    pub rate_hz: f64,
 }
 
 /// The solver thread's end of the channels, and what it says when it starts.
@@ -52,8 +63,14 @@ pub struct SolverThread {
 
 /// Starts the solver for `case` on its own thread; returns once the GPU is open and the case
 /// built, with the observations at t = 0. With `out`, the thread writes the same CSV files as
-/// `simulate`, one row per chunk.
-pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
+/// `simulate`, one row per chunk; with `frames`, it offers the particles to visualisers after
+/// each chunk, when a frame is due (a frame service that cannot be opened is logged and left
+/// out: the twin runs without it).
+pub fn spawn(
+    case: Case,
+    out: Option<PathBuf>,
+    frames: Option<FrameSettings>,
+) -> Result<SolverThread> {
     let (cmd_tx, cmd_rx) = mpsc::channel::<Command>();
     let (rep_tx, rep_rx) = async_mpsc::unbounded_channel();
     let (ready_tx, ready_rx) = mpsc::channel::<Result<(String, usize, Observations), String>>();
@@ -93,6 +110,23 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                 .open_flume
                 .as_ref()
                 .map(|_| flume_solver::case::parked_phase(&case));
+            let mut frames = frames.and_then(|f| {
+                match Frames::open(
+                    &f.service,
+                    sim.particle_count(),
+                    parked.unwrap_or(0),
+                    f.rate_hz,
+                ) {
+                    Ok(fr) => {
+                        println!("particle frames: iceoryx2 service {}", f.service);
+                        Some(fr)
+                    }
+                    Err(e) => {
+                        log::error!("no particle frames for visualisers: {e:#}");
+                        None
+                    }
+                }
+            });
             while let Ok(command) = cmd_rx.recv() {
                 k += 1;
                 let report = match command {
@@ -101,6 +135,9 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                         inflow,
                         cloud,
                     } => run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
+                        if let Some(f) = frames.as_mut() {
+                            f.offer(&sim);
+                        }
                         let cloud = if cloud {
                             Some(cloud_points(&sim, parked)?)
                         } else {
@@ -113,6 +150,8 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                             refused_inflows: refused,
                             cloud,
                             reset: false,
+                            frames_sent: frames.as_ref().map_or(0, |f| f.sent),
+                            frames_skipped: frames.as_ref().map_or(0, |f| f.skipped),
                         })
                     }),
                     Command::Reset => {
@@ -128,6 +167,8 @@ pub fn spawn(case: Case, out: Option<PathBuf>) -> Result<SolverThread> {
                                     refused_inflows: 0,
                                     cloud: None,
                                     reset: true,
+                                    frames_sent: frames.as_ref().map_or(0, |f| f.sent),
+                                    frames_skipped: frames.as_ref().map_or(0, |f| f.skipped),
                                 })
                             })
                     }
