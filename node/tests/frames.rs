@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{gpu, repo_file};
+use common::{gpu, printed, python_has, repo_file};
 use serde_json::Value;
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -109,11 +109,7 @@ fn frames_of(child: Child) -> Vec<Value> {
 
 fn ends_well(twin: Child) -> String {
     let out = twin.wait_with_output().expect("the twin ends");
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let log = printed(&out);
     assert!(out.status.success(), "{log}");
     log
 }
@@ -121,16 +117,7 @@ fn ends_well(twin: Child) -> String {
 #[test]
 fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
     let Some(_gpu) = gpu() else { return };
-    let have = Command::new("python3")
-        .args(["-c", "import iceoryx2, rerun"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !have {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true and no iceoryx2 or rerun for python3 (scripts/test.sh installs them)"
-        );
-        eprintln!("note: skipping, pip install iceoryx2 rerun-sdk");
+    if !python_has("iceoryx2, rerun", "iceoryx2 rerun-sdk") {
         return;
     }
     let service = format!("flume_twin/test_{}", std::process::id());

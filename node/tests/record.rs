@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{gpu, repo_file};
+use common::{gpu, printed, python_has, repo_file};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -88,16 +88,7 @@ fn full(topic: &str) -> String {
 #[test]
 fn sigterm_finishes_the_recording_and_kill_9_keeps_its_flushed_chunks() {
     let Some(_gpu) = gpu() else { return };
-    let python_ok = Command::new("python3")
-        .args(["-c", "import mcap_ros2"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !python_ok {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true and no mcap-ros2-support"
-        );
-        eprintln!("note: skipping, pip install mcap mcap-ros2-support");
+    if !python_has("mcap_ros2", "mcap mcap-ros2-support") {
         return;
     }
     let dir = std::env::temp_dir().join(format!("flume-record-{}", std::process::id()));
@@ -115,11 +106,7 @@ fn sigterm_finishes_the_recording_and_kill_9_keeps_its_flushed_chunks() {
         .expect("kill");
     assert!(status.success());
     let out = twin.wait_with_output().expect("the twin exits");
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let log = printed(&out);
     assert!(out.status.success(), "{log}");
     assert!(
         log.contains("plays the sensors") && log.contains("terminated at"),
@@ -211,11 +198,7 @@ fn sigterm_finishes_the_recording_and_kill_9_keeps_its_flushed_chunks() {
         ])
         .output()
         .expect("replays");
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let log = printed(&out);
     assert!(out.status.success(), "{log}");
     assert!(
         log.contains("is damaged: read") && log.contains("replayed 0.100 s"),

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{csv_rows, gpu, repo_file};
+use common::{csv_rows, gpu, printed, python_has, repo_file};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -38,11 +38,7 @@ fn replay(recording: &Path, extra: &[&str]) -> (bool, String) {
         .args(extra)
         .output()
         .expect("runs the binary");
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let log = printed(&out);
     (out.status.success(), log)
 }
 
@@ -69,23 +65,10 @@ fn secs(stamp: &Value) -> f64 {
     num(&stamp["sec"]) + num(&stamp["nanosec"]) * 1e-9 - ORIGIN_S
 }
 
-fn have_python_mcap() -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", "import mcap_ros2"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    assert!(
-        ok || std::env::var("CI").as_deref() != Ok("true"),
-        "CI=true and no mcap-ros2-support for python3 (scripts/test.sh installs it)"
-    );
-    ok
-}
-
 #[test]
 fn the_bundled_session_replays_bit_identically_and_makes_physical_sense() {
     let Some(_gpu) = gpu() else { return };
-    if !have_python_mcap() {
-        eprintln!("note: skipping, pip install mcap mcap-ros2-support");
+    if !python_has("mcap_ros2", "mcap mcap-ros2-support") {
         return;
     }
     let dir = std::env::temp_dir().join(format!("flume-replay-{}", std::process::id()));

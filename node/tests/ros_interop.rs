@@ -5,25 +5,10 @@
 
 mod common;
 
-use common::{csv_rows, gpu, repo_file};
+use common::{csv_rows, gpu, python_has, repo_file};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::process::{Command, Stdio};
-
-fn have_cyclonedds() -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", "import cyclonedds"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true and no cyclonedds for python3 (scripts/test.sh installs it)"
-        );
-        eprintln!("note: skipping the DDS interop test: pip install cyclonedds");
-    }
-    ok
-}
 
 fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
@@ -32,7 +17,7 @@ fn num(v: &Value) -> f64 {
 #[test]
 fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
     let Some(_gpu) = gpu() else { return };
-    if !have_cyclonedds() {
+    if !python_has("cyclonedds", "cyclonedds") {
         return;
     }
     let dir = std::env::temp_dir().join(format!("flume-ros-interop-{}", std::process::id()));

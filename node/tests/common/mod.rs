@@ -1,4 +1,5 @@
-//! What the binary's tests share: repository paths, the GPU gate and the CSV reader.
+//! What the binary's tests share: repository paths, the GPU gate, the Python gate and the CSV
+//! reader.
 //!
 //! GPU tests skip with a note when no adapter is found, except under CI=true (CI has lavapipe),
 //! where a missing adapter is a failure. Within a test binary they run one at a time: lavapipe
@@ -51,4 +52,30 @@ pub fn csv_rows(path: &Path) -> Vec<BTreeMap<String, String>> {
                 .collect()
         })
         .collect()
+}
+
+/// Whether python3 can `import modules` (comma-separated); without them a test skips with a
+/// note, except under CI=true, where `scripts/test.sh` installs them and a miss is a failure.
+pub fn python_has(modules: &str, pip: &str) -> bool {
+    let ok = std::process::Command::new("python3")
+        .args(["-c", &format!("import {modules}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "CI=true and python3 cannot import {modules} (scripts/test.sh installs them)"
+        );
+        eprintln!("note: skipping, pip install {pip}");
+    }
+    ok
+}
+
+/// What a finished process printed, stdout then stderr.
+pub fn printed(out: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
 }
