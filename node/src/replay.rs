@@ -8,9 +8,9 @@
 use crate::bag::writer::Channel as BagChannel;
 use crate::bag::{BagWriter, Recorded, Recording};
 use crate::cli::ReplayArgs;
-use crate::inputs::{self, InputGate, Reading, Readings};
+use crate::inputs::{self, InputGate, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
-use crate::samples::{Input, decode, role};
+use crate::samples::{Admitted, Input, decode, role};
 use crate::solver_thread::{self, Command};
 use crate::topics;
 use crate::visual;
@@ -184,32 +184,19 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
     let mut inflow: Vec<(f64, f64)> = carried.map(|(_, q)| (0.0, q)).into_iter().collect();
     let mut measured: Vec<Readings> = vec![Readings::default(); gauge_names.len()];
     let mut fed: Vec<usize> = Vec::new();
+    let mount_height_m = vec![limits.flume_height_m; gauge_names.len()];
     for &(k, input) in &events {
         let now = feed[k].0.log_ns as f64 * 1e-9;
         fed.push(k);
-        match input {
-            Input::Inflow { stamp_s, q } => {
-                if gate.discharge("inflow", stamp_s, q, now).is_ok() {
-                    inflow.push((stamp_s - origin, q));
-                }
-            }
-            Input::Gauge { index, sample } => {
-                let name = &gauge_names[index];
-                let level = match sample.reading {
-                    Reading::Level(l) => gate.level(name, sample.stamp_s, l, now).map(|()| l),
-                    Reading::Range { range, min, max } => gate.range(
-                        name,
-                        sample.stamp_s,
-                        range,
-                        (min, max),
-                        limits.flume_height_m,
-                        now,
-                    ),
-                };
-                if let Ok(level) = level {
-                    measured[index].push(sample.stamp_s, level);
-                }
-            }
+        // A replayed range sensor is taken as mounted at the flume's top.
+        match input.admit(&mut gate, &gauge_names, &mount_height_m, now) {
+            Some(Admitted::Inflow { stamp_s, q }) => inflow.push((stamp_s - origin, q)),
+            Some(Admitted::Level {
+                index,
+                stamp_s,
+                level_m,
+            }) => measured[index].push(stamp_s, level_m),
+            None => {}
         }
     }
     println!(

@@ -8,11 +8,11 @@
 use crate::bag::Recording;
 use crate::bag::TopicQos;
 use crate::cli::{GaugeMsg, RunArgs};
-use crate::inputs::{InputGate, Limits, Reading, Readings};
+use crate::inputs::{InputGate, Limits, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
 use crate::pacer::Pacer;
 use crate::ros_args::{ParamValue, RosArgs};
-use crate::samples::{Input, Sample, decode, role};
+use crate::samples::{Admitted, Input, Sample, decode, role};
 use crate::solver_thread::{self, Command, Report};
 use crate::tap::{Outlet, Tap, input_channels};
 use crate::topics;
@@ -818,26 +818,17 @@ fn take(
     mount_height_m: &[f64],
     now: f64,
 ) {
-    match input {
-        Input::Inflow { stamp_s, q } => {
-            if gate.discharge("inflow", stamp_s, q, now).is_ok() {
-                pacer.inflow(stamp_s, q);
-            }
+    match input.admit(gate, gauge_names, mount_height_m, now) {
+        Some(Admitted::Inflow { stamp_s, q }) => pacer.inflow(stamp_s, q),
+        Some(Admitted::Level {
+            index,
+            stamp_s,
+            level_m,
+        }) => {
+            pacer.heard(stamp_s);
+            measured[index].push(stamp_s, level_m);
         }
-        Input::Gauge { index, sample } => {
-            let name = &gauge_names[index];
-            let stamp = sample.stamp_s;
-            let level = match sample.reading {
-                Reading::Level(level) => gate.level(name, stamp, level, now).map(|()| level),
-                Reading::Range { range, min, max } => {
-                    gate.range(name, stamp, range, (min, max), mount_height_m[index], now)
-                }
-            };
-            if let Ok(level) = level {
-                pacer.heard(stamp);
-                measured[index].push(stamp, level);
-            }
-        }
+        None => {}
     }
 }
 

@@ -2,7 +2,7 @@
 //! came (so it can be recorded), and what the input gate needs from it.
 
 use crate::bag::Recorded;
-use crate::inputs::{GaugeSample, Reading};
+use crate::inputs::{GaugeSample, InputGate, Reading};
 use crate::topics;
 use anyhow::Result;
 use flume_msgs::RosMessage;
@@ -25,11 +25,57 @@ pub enum Input {
     Gauge { index: usize, sample: GaugeSample },
 }
 
+/// A sample the gate let through: a discharge, or gauge `index`'s level above the floor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Admitted {
+    Inflow {
+        stamp_s: f64,
+        q: f64,
+    },
+    Level {
+        index: usize,
+        stamp_s: f64,
+        level_m: f64,
+    },
+}
+
 impl Input {
     pub fn stamp_s(&self) -> f64 {
         match self {
             Input::Inflow { stamp_s, .. } => *stamp_s,
             Input::Gauge { sample, .. } => sample.stamp_s,
+        }
+    }
+
+    /// Passes the sample through `gate` at node-clock time `now`; a range becomes a level
+    /// below its gauge's mount height (`mount_height_m`, by gauge). None when refused (the
+    /// gate has logged and counted it).
+    pub fn admit(
+        self,
+        gate: &mut InputGate,
+        gauge_names: &[String],
+        mount_height_m: &[f64],
+        now: f64,
+    ) -> Option<Admitted> {
+        match self {
+            Input::Inflow { stamp_s, q } => gate
+                .discharge("inflow", stamp_s, q, now)
+                .ok()
+                .map(|()| Admitted::Inflow { stamp_s, q }),
+            Input::Gauge { index, sample } => {
+                let (name, stamp_s) = (&gauge_names[index], sample.stamp_s);
+                let level = match sample.reading {
+                    Reading::Level(l) => gate.level(name, stamp_s, l, now).map(|()| l),
+                    Reading::Range { range, min, max } => {
+                        gate.range(name, stamp_s, range, (min, max), mount_height_m[index], now)
+                    }
+                };
+                level.ok().map(|level_m| Admitted::Level {
+                    index,
+                    stamp_s,
+                    level_m,
+                })
+            }
         }
     }
 }

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{gpu, printed, python_has, repo_file};
+use common::{ULBRA_CI, gpu, printed, python_has, repo_file};
 use serde_json::Value;
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -19,13 +19,9 @@ const PARTICLES: u64 = 4570;
 fn twin(service: &str, until: &str) -> Child {
     Command::new(env!("CARGO_BIN_EXE_flume-twin"))
         .current_dir(repo_file(""))
+        .args(["run", "launch_configs/ulbra_flume.yaml"])
+        .args(ULBRA_CI)
         .args([
-            "run",
-            "launch_configs/ulbra_flume.yaml",
-            "--set",
-            "numerics.dp_m=0.01",
-            "--set",
-            "open_flume.reservoir_particles=2500",
             "--loopback",
             "--no-replay",
             "--until",

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{gpu, printed, python_has, repo_file};
+use common::{ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -17,13 +17,9 @@ use std::time::{Duration, Instant};
 fn start(record: &Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_flume-twin"))
         .current_dir(repo_file(""))
+        .args(["run", "launch_configs/ulbra_flume.yaml"])
+        .args(ULBRA_CI)
         .args([
-            "run",
-            "launch_configs/ulbra_flume.yaml",
-            "--set",
-            "numerics.dp_m=0.01",
-            "--set",
-            "open_flume.reservoir_particles=2500",
             "--loopback",
             "--silent-wait-s",
             "0.5",
@@ -57,19 +53,9 @@ fn wait_for(path: &Path, bytes: u64) {
     }
 }
 
-fn read_mcap(path: &Path) -> Value {
-    let out = Command::new("python3")
-        .arg(repo_file("tests/interop/read_mcap.py"))
-        .arg(path)
-        .args([format!("{}/gauges/p1", ns())])
-        .output()
-        .expect("runs python3");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+/// The recording as Python reads it, with the gauge P1's levels decoded.
+fn read_p1(path: &Path) -> Value {
+    read_mcap(path, &[format!("{}/gauges/p1", ns())])
 }
 
 /// Messages on `topic`, relative to the twin's namespace unless absolute.
@@ -112,7 +98,7 @@ fn sigterm_finishes_the_recording_and_kill_9_keeps_its_flushed_chunks() {
         log.contains("plays the sensors") && log.contains("terminated at"),
         "{log}"
     );
-    let got = read_mcap(&whole);
+    let got = read_p1(&whole);
     assert!(got["error"].is_null(), "{}", got["error"]);
     assert_eq!(got["profile"], "ros2");
     for topic in [
@@ -165,7 +151,7 @@ fn sigterm_finishes_the_recording_and_kill_9_keeps_its_flushed_chunks() {
     wait_for(&killed, 40_000);
     twin.kill().expect("kill -9");
     twin.wait().expect("reaped");
-    let got = read_mcap(&killed);
+    let got = read_p1(&killed);
     let error = got["error"].as_str().unwrap_or_default();
     assert!(
         !error.is_empty(),
@@ -186,16 +172,9 @@ fn sigterm_finishes_the_recording_and_kill_9_keeps_its_flushed_chunks() {
         .current_dir(repo_file(""))
         .arg("replay")
         .arg(&killed)
-        .args([
-            "--config",
-            "launch_configs/ulbra_flume.yaml",
-            "--set",
-            "numerics.dp_m=0.01",
-            "--set",
-            "open_flume.reservoir_particles=2500",
-            "--until",
-            "0.1",
-        ])
+        .args(["--config", "launch_configs/ulbra_flume.yaml"])
+        .args(ULBRA_CI)
+        .args(["--until", "0.1"])
         .output()
         .expect("replays");
     let log = printed(&out);

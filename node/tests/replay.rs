@@ -7,18 +7,11 @@
 
 mod common;
 
-use common::{csv_rows, gpu, printed, python_has, repo_file};
+use common::{ULBRA_CI, csv_rows, gpu, printed, python_has, read_mcap, repo_file};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The ULBRA flume at CI size (solver/tests/scour.rs uses the same).
-const CI_SIZE: [&str; 4] = [
-    "--set",
-    "numerics.dp_m=0.01",
-    "--set",
-    "open_flume.reservoir_particles=2500",
-];
 const DP: f64 = 0.01;
 const BED_M: f64 = 0.055;
 /// The session's start (its stamps' origin), s since the epoch.
@@ -34,27 +27,12 @@ fn replay(recording: &Path, extra: &[&str]) -> (bool, String) {
         .arg(recording)
         .arg("--config")
         .arg(repo_file("launch_configs/ulbra_flume.yaml"))
-        .args(CI_SIZE)
+        .args(ULBRA_CI)
         .args(extra)
         .output()
         .expect("runs the binary");
     let log = printed(&out);
     (out.status.success(), log)
-}
-
-fn read_mcap(path: &Path, topics: &[&str]) -> Value {
-    let out = Command::new("python3")
-        .arg(repo_file("tests/interop/read_mcap.py"))
-        .arg(path)
-        .args(topics)
-        .output()
-        .expect("runs python3");
-    assert!(
-        out.status.success(),
-        "read_mcap.py failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
 }
 
 fn num(v: &Value) -> f64 {
@@ -281,4 +259,70 @@ fn a_damaged_recording_replays_up_to_the_damage() {
         assert!(log.contains("replayed 0.200 s"), "{log}");
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The bundled session is what its documented command makes, byte for byte: anyone can
+/// remake it (README, "Recording and replay").
+#[test]
+fn the_bundled_session_is_remade_by_its_generator() {
+    let out = std::env::temp_dir().join(format!("flume-session-{}.mcap", std::process::id()));
+    let made = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+        .current_dir(repo_file(""))
+        .args(["make-session", "launch_configs/ulbra_flume.yaml", "--out"])
+        .arg(&out)
+        .output()
+        .expect("runs the binary");
+    assert!(made.status.success(), "{}", printed(&made));
+    assert!(
+        printed(&made).contains("2404 messages over 75 s"),
+        "{}",
+        printed(&made)
+    );
+    let (remade, bundled) = (
+        std::fs::read(&out).expect("made"),
+        std::fs::read(session()).expect("bundled"),
+    );
+    assert!(
+        remade == bundled,
+        "make-session no longer makes the bundled session"
+    );
+    std::fs::remove_file(&out).ok();
+}
+
+/// `--start-s` starts later with the discharge then in force (2.5 m3/h from 40 s), and
+/// `--topics` replays only the topics named, saying which it passed over.
+#[test]
+fn a_replay_can_start_later_on_chosen_topics() {
+    let Some(_gpu) = gpu() else { return };
+    let csv = std::env::temp_dir().join(format!("flume-replay-start-{}", std::process::id()));
+    let (ok, log) = replay(
+        &session(),
+        &[
+            "--start-s",
+            "45",
+            "--topics",
+            "/inflow,/gauges/p1",
+            "--until",
+            "0.2",
+            "--csv",
+            csv.to_str().expect("utf-8"),
+        ],
+    );
+    assert!(ok, "{log}");
+    assert!(
+        log.contains("not replayed: /gauges/p2") && log.contains("not replayed: /gauges/p3"),
+        "{log}"
+    );
+    assert!(log.contains("replayed 0.200 s"), "{log}");
+    let rows = csv_rows(&csv.join("eroded_mass.csv"));
+    let q: f64 = rows[1]["inflow_m3_per_s"].parse().expect("q");
+    // The flow meter's 1 % noise: four sigmas.
+    let due = 2.5 / 3600.0;
+    assert!(
+        (q - due).abs() < 0.04 * due,
+        "the inlet ran {q} m3/s, not 2.5 m3/h"
+    );
+    let gauges = csv_rows(&csv.join("gauges.csv"));
+    assert_eq!(gauges.len(), 3, "t = 0, 0.1 and 0.2 s");
+    std::fs::remove_dir_all(&csv).ok();
 }

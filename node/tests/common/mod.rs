@@ -79,3 +79,29 @@ pub fn printed(out: &std::process::Output) -> String {
         String::from_utf8_lossy(&out.stderr)
     )
 }
+
+/// The ULBRA flume at CI size (dp = 1 cm, 4,570 particles), as solver/tests/scour.rs builds
+/// it: the arguments after the case file.
+pub const ULBRA_CI: [&str; 4] = [
+    "--set",
+    "numerics.dp_m=0.01",
+    "--set",
+    "open_flume.reservoir_particles=2500",
+];
+
+/// A recording as Python's `mcap` and `mcap-ros2-support` read it
+/// (`tests/interop/read_mcap.py`), with the messages of `topics` decoded.
+pub fn read_mcap<S: AsRef<std::ffi::OsStr>>(path: &Path, topics: &[S]) -> serde_json::Value {
+    let out = std::process::Command::new("python3")
+        .arg(repo_file("tests/interop/read_mcap.py"))
+        .arg(path)
+        .args(topics)
+        .output()
+        .expect("runs python3");
+    assert!(
+        out.status.success(),
+        "read_mcap.py failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON")
+}
