@@ -24,6 +24,7 @@ use ros2_client::{
     Context, MessageTypeName, Name, Node, NodeName, NodeOptions, Parameter, ParameterValue,
     QosProfile, ServiceMapping, ServiceTypeName,
 };
+use std::io::{BufRead, BufReader};
 use std::net::Ipv4Addr;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
@@ -113,7 +114,7 @@ where
 #[test]
 fn parameters_and_services_from_another_process_control_the_twin() {
     let Some(_gpu) = gpu() else { return };
-    let _twin = Twin(
+    let mut twin = Twin(
         Command::new(env!("CARGO_BIN_EXE_flume-twin"))
             .args([
                 "run",
@@ -133,12 +134,25 @@ fn parameters_and_services_from_another_process_control_the_twin() {
                 "-p",
                 "gauge_mount_height_m.p1:=0.2",
             ])
-            .stdout(Stdio::null())
+            .stdout(Stdio::piped())
             // A twin that fails to start says why in the test's output.
             .stderr(Stdio::inherit())
             .spawn()
             .expect("the twin starts"),
     );
+    // This side's DDS participant starts after the twin's: when it came first, on a loaded
+    // machine the twin's parameter services were at times never matched (RustDDS discovery).
+    // The twin prints `node:` just before it starts DDS; the rest of its output is drained.
+    let mut lines = BufReader::new(twin.0.stdout.take().expect("stdout")).lines();
+    loop {
+        match lines.next() {
+            Some(Ok(line)) if line.starts_with("node:") => break,
+            Some(Ok(_)) => continue,
+            _ => panic!("the twin ended before starting its node"),
+        }
+    }
+    std::thread::spawn(move || lines.for_each(drop));
+    std::thread::sleep(Duration::from_secs(2));
     let runtime = tokio::runtime::Runtime::new().expect("runtime");
     runtime.block_on(async {
         let participant = DomainParticipantBuilder::new(0)
