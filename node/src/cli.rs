@@ -153,24 +153,48 @@ pub struct ReplayArgs {
     /// The recording (MCAP) whose inflow and gauge topics drive the twin.
     pub recording: PathBuf,
     /// Case file (YAML) with an open flume, e.g. launch_configs/ulbra_flume.yaml.
-    #[arg(long, value_name = "CASE")]
-    pub config: PathBuf,
+    #[arg(
+        long,
+        value_name = "CASE",
+        required_unless_present = "publish",
+        conflicts_with = "publish"
+    )]
+    pub config: Option<PathBuf>,
     /// Override a field of the case, e.g. `--set numerics.dp_m=0.01` (repeatable; a number
     /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
+    #[arg(long = "set", value_name = "KEY=VALUE", conflicts_with = "publish")]
     pub set: Vec<String>,
     /// Write the replayed inputs and the twin's outputs to this recording (MCAP).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "publish")]
     pub out: Option<PathBuf>,
     /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", conflicts_with = "publish")]
     pub csv: Option<PathBuf>,
-    /// Pace the replay at this many simulated seconds per wall second [default: as fast as
-    /// the adapter goes].
+    /// Pace the replay at this many recorded seconds per wall second [default: as fast as
+    /// the adapter goes; 1 with --publish].
     #[arg(long, value_name = "X", value_parser = positive)]
     pub rate: Option<f64>,
+    /// Play the sensor topics on the wire (ROS 2 over DDS) with /clock on the recording's
+    /// time, as `ros2 bag play --clock` does, instead of feeding a twin in-process; a twin
+    /// run with `--ros-args -p use_sim_time:=true` follows that clock. Topics keep their
+    /// recorded names; `--ros-args -r FROM:=TO` renames them.
+    #[arg(long)]
+    pub publish: bool,
+    /// /clock messages per wall second (with --publish).
+    #[arg(long, value_name = "HZ", default_value_t = 40.0, value_parser = positive)]
+    pub clock_hz: f64,
+    /// With --publish, /clock holds at the start this long before the first sample goes
+    /// out, so that subscribers have matched, s.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub delay_s: f64,
+    /// DDS domain (with --publish).
+    #[arg(long, default_value_t = 0)]
+    pub domain_id: u16,
+    /// With --publish, DDS on the loopback interface only.
+    #[arg(long)]
+    pub loopback: bool,
     /// Replay only these recorded topics (comma-separated) [default: every inflow and gauge
-    /// topic of the case].
+    /// topic of the case; with --publish, every inflow and gauge topic].
     #[arg(long, value_name = "T1,T2,...", value_delimiter = ',')]
     pub topics: Vec<String>,
     /// Start this far into the recording, s; the discharge in force then holds from the start.
@@ -180,7 +204,7 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "T_S", value_parser = positive)]
     pub until: Option<f64>,
     /// The solver's chunk: outputs are written at multiples of it, s.
-    #[arg(long, value_name = "S", default_value_t = 0.1, value_parser = positive)]
+    #[arg(long, value_name = "S", default_value_t = 0.1, value_parser = positive, conflicts_with = "publish")]
     pub output_interval_s: f64,
     /// A gauge whose last sample is older than this at an output is flagged stale, s.
     #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = positive)]

@@ -6,12 +6,14 @@
 mod bag;
 mod bench;
 mod cli;
+mod clock;
 mod frames;
 mod inflow;
 mod inputs;
 mod observed;
 mod output;
 mod pacer;
+mod play;
 mod replay;
 mod ros_args;
 mod run;
@@ -44,7 +46,7 @@ fn main() -> ExitCode {
         cli::Command::Simulate(args) => simulate::run(&args),
         cli::Command::Bench(args) => bench::run(&args),
         cli::Command::Run(args) => run::run(&args, &ros_args),
-        cli::Command::Replay(args) => replay::run(&args),
+        cli::Command::Replay(args) => replay::run(&args, &ros_args),
         cli::Command::MakeSession(args) => session::run(&args),
     };
     match result {

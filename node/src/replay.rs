@@ -3,7 +3,8 @@
 //! stamp; the solver runs in lock-step chunks ending on a fixed grid of `--output-interval-s`,
 //! each discharge applied at its own stamp, so the same recording on the same adapter gives
 //! the same bits out. The output recording holds the replayed inputs (as recorded) and the
-//! twin's outputs, stamped on the recording's clock.
+//! twin's outputs, stamped on the recording's clock. With `--publish` the sensor topics go on
+//! the wire instead (`play.rs`).
 
 use crate::bag::writer::Channel as BagChannel;
 use crate::bag::{BagWriter, Recorded, Recording};
@@ -107,14 +108,22 @@ impl Outputs {
     }
 }
 
-/// Replays `args.recording` through the twin.
-pub fn run(args: &ReplayArgs) -> Result<()> {
-    let case =
-        Case::from_path_with(&args.config, &args.set).context("the case file was refused")?;
+/// Replays `args.recording` through the twin, or with `--publish` on the wire.
+pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
+    if args.publish {
+        return crate::play::run(args, ros_args);
+    }
+    if !ros_args.is_empty() {
+        bail!("--ros-args is for --publish: an in-process replay has no ROS node");
+    }
+    let Some(config) = &args.config else {
+        bail!("--config CASE is needed to replay through the twin");
+    };
+    let case = Case::from_path_with(config, &args.set).context("the case file was refused")?;
     if case.open_flume.is_none() {
         bail!(
             "{}: the twin needs an open flume for the recorded inflow to drive",
-            args.config.display()
+            config.display()
         );
     }
     let recording = Recording::read(&args.recording)?;

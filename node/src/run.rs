@@ -8,6 +8,7 @@
 use crate::bag::Recording;
 use crate::bag::TopicQos;
 use crate::cli::{GaugeMsg, RunArgs};
+use crate::clock::NodeClock;
 use crate::inputs::{InputGate, Limits, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
 use crate::pacer::Pacer;
@@ -41,16 +42,10 @@ use std::net::Ipv4Addr;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
-/// The node's clock: ROS time, seconds since the epoch.
-pub fn now_s() -> f64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0.0, |d| d.as_secs_f64())
-}
-
-fn qos(t: TopicQos) -> QosProfile {
+/// A topic's QoS as ros2-client takes it.
+pub fn qos(t: TopicQos) -> QosProfile {
     let q = QosProfile::publisher_default()
         .durability(if t.transient_local {
             Durability::TransientLocal
@@ -65,18 +60,19 @@ fn qos(t: TopicQos) -> QosProfile {
     }
 }
 
-fn type_name(def: &MsgDef) -> MessageTypeName {
+pub fn type_name(def: &MsgDef) -> MessageTypeName {
     MessageTypeName::new(def.package, def.name)
 }
 
-/// A topic name after the remaps, as ros2-client takes it.
-fn topic_name(ros: &RosArgs, name: &str) -> Result<Name> {
-    let remapped = ros.remap(name);
-    Name::parse(&remapped).map_err(|e| anyhow!("topic {remapped:?}: {e}"))
+/// A full topic name (`/ns/name`) as ros2-client takes it. Names go to ros2-client absolute:
+/// a relative one under the root namespace would reach DDS as `rt//name`, which no other ROS
+/// node uses.
+pub fn topic_name(full: &str) -> Result<Name> {
+    Name::parse(full).map_err(|e| anyhow!("topic {full:?}: {e}"))
 }
 
-/// A topic's full name after the remaps, as a recording names it.
-fn full_topic(namespace: &str, ros: &RosArgs, name: &str) -> String {
+/// A topic's full name after the remaps, as the wire and a recording name it.
+pub fn full_topic(namespace: &str, ros: &RosArgs, name: &str) -> String {
     let remapped = ros.remap(name);
     if remapped.starts_with('/') {
         remapped
@@ -88,7 +84,6 @@ fn full_topic(namespace: &str, ros: &RosArgs, name: &str) -> String {
 /// A publisher of `M` on `name`, recorded when the node records.
 fn outlet<M: RosMessage + Serialize>(
     node: &mut Node,
-    ros: &RosArgs,
     recorder: &mut Tap,
     full: &dyn Fn(&str) -> String,
     name: &str,
@@ -96,7 +91,7 @@ fn outlet<M: RosMessage + Serialize>(
 ) -> Result<Outlet<M>> {
     let q = qos(topic_qos);
     let topic = node
-        .create_topic(&topic_name(ros, name)?, type_name(M::DEF), &q)
+        .create_topic(&topic_name(&full(name))?, type_name(M::DEF), &q)
         .with_context(|| format!("cannot create topic {name}"))?;
     Ok(Outlet {
         publisher: node
@@ -108,15 +103,29 @@ fn outlet<M: RosMessage + Serialize>(
 
 fn subscription<M: RosMessage + DeserializeOwned + 'static>(
     node: &mut Node,
-    ros: &RosArgs,
+    full: &dyn Fn(&str) -> String,
     name: &str,
     qos: QosProfile,
 ) -> Result<Subscription<M>> {
     let topic = node
-        .create_topic(&topic_name(ros, name)?, type_name(M::DEF), &qos)
+        .create_topic(&topic_name(&full(name))?, type_name(M::DEF), &qos)
         .with_context(|| format!("cannot create topic {name}"))?;
     node.create_subscription::<M>(&topic, Some(qos))
         .with_context(|| format!("cannot subscribe to {name}"))
+}
+
+/// ROS 2 on DDS domain `domain_id`, on the loopback interface only when `loopback`.
+pub fn dds_context(loopback: bool, domain_id: u16) -> Result<Context> {
+    if loopback {
+        let participant = DomainParticipantBuilder::new(domain_id)
+            .with_only_networks([Ipv4Addr::LOCALHOST])
+            .build()
+            .context("cannot start DDS on the loopback interface")?;
+        Context::from_domain_participant(participant)
+    } else {
+        Context::with_options(ros2_client::ContextOptions::new().domain_id(domain_id))
+    }
+    .context("cannot start ROS 2 (DDS)")
 }
 
 /// Settings of a run, from the command line, then parameter files and `-p` (which win).
@@ -130,6 +139,8 @@ struct Settings {
     /// flume floor, m (parameters `gauge_mount_height_m.p1`, ...).
     gauges: Vec<String>,
     mount_height_m: Vec<f64>,
+    /// The node's time is `/clock` (read at start only).
+    use_sim_time: bool,
 }
 
 impl Settings {
@@ -148,6 +159,7 @@ impl Settings {
             frame_id: "flume".into(),
             gauges: gauges.to_vec(),
             mount_height_m: vec![flume_top_m; gauges.len()],
+            use_sim_time: false,
         };
         for (name, value) in params {
             let gauge = name.strip_prefix(MOUNT_HEIGHT);
@@ -182,11 +194,10 @@ impl Settings {
                 ParamValue::String(f) if !f.is_empty() => self.frame_id = f.clone(),
                 other => return Err(format!("must be a non-empty string, got {other:?}")),
             },
-            "use_sim_time" => {
-                if !matches!(value, ParamValue::Bool(_)) {
-                    return Err(format!("must be true or false, got {value:?}"));
-                }
-            }
+            "use_sim_time" => match value {
+                ParamValue::Bool(b) => self.use_sim_time = *b,
+                other => return Err(format!("must be true or false, got {other:?}")),
+            },
             other => match other
                 .strip_prefix(MOUNT_HEIGHT)
                 .and_then(|g| self.gauges.iter().position(|n| n == g))
@@ -211,6 +222,7 @@ impl Settings {
             ),
             ("stale_after_s", ParameterValue::Double(self.stale_after_s)),
             ("frame_id", ParameterValue::String(self.frame_id.clone())),
+            ("use_sim_time", ParameterValue::Boolean(self.use_sim_time)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
@@ -347,16 +359,7 @@ async fn serve(
 
     let live = Arc::new(Mutex::new(settings.clone()));
     let mut settings = settings;
-    let context = if args.loopback {
-        let participant = DomainParticipantBuilder::new(args.domain_id)
-            .with_only_networks([Ipv4Addr::LOCALHOST])
-            .build()
-            .context("cannot start DDS on the loopback interface")?;
-        Context::from_domain_participant(participant)
-    } else {
-        Context::with_options(ros2_client::ContextOptions::new().domain_id(args.domain_id))
-    }
-    .context("cannot start ROS 2 (DDS)")?;
+    let context = dds_context(args.loopback, args.domain_id)?;
     let mut node = context
         .new_node(
             NodeName::new(&namespace, &node_name)
@@ -367,8 +370,9 @@ async fn serve(
     let spinner = node.spinner().context("cannot spin the node")?;
     tokio::spawn(spinner.spin());
 
+    let full = |name: &str| full_topic(&namespace, &ros, name);
     let inflow_sub =
-        subscription::<Discharge>(&mut node, &ros, topics::INFLOW, qos(topics::INFLOW_QOS))?;
+        subscription::<Discharge>(&mut node, &full, topics::INFLOW, qos(topics::INFLOW_QOS))?;
     let mut level_subs = Vec::new();
     let mut range_subs = Vec::new();
     for g in &gauge_names {
@@ -376,20 +380,31 @@ async fn serve(
         match args.gauge_msg {
             GaugeMsg::WaterLevel => level_subs.push(subscription::<WaterLevel>(
                 &mut node,
-                &ros,
+                &full,
                 &topic,
                 qos(topics::GAUGE_QOS),
             )?),
             GaugeMsg::Range => range_subs.push(subscription::<Range>(
                 &mut node,
-                &ros,
+                &full,
                 &topic,
                 qos(topics::GAUGE_QOS),
             )?),
         }
     }
+    // ros2-client's own simulated time listens to /clock as builtin_interfaces/Time, which a
+    // player's rosgraph_msgs/Clock does not match; the node keeps its own.
+    let clock_sub = if settings.use_sim_time {
+        Some(subscription::<Clock>(
+            &mut node,
+            &full,
+            topics::CLOCK,
+            qos(topics::STREAM_QOS),
+        )?)
+    } else {
+        None
+    };
     let mut recorder = Tap::create(args.record.as_deref())?;
-    let full = |name: &str| full_topic(&namespace, &ros, name);
     let inputs = input_channels(
         &mut recorder,
         &full(topics::INFLOW),
@@ -404,7 +419,6 @@ async fn serve(
     recorder.set_inputs(inputs);
     let bed_out = outlet::<BedProfile>(
         &mut node,
-        &ros,
         &mut recorder,
         &full,
         topics::BED_PROFILE,
@@ -412,7 +426,6 @@ async fn serve(
     )?;
     let eroded_out = outlet::<ErodedMass>(
         &mut node,
-        &ros,
         &mut recorder,
         &full,
         topics::ERODED_MASS,
@@ -420,23 +433,25 @@ async fn serve(
     )?;
     let compare_out = outlet::<GaugeComparison>(
         &mut node,
-        &ros,
         &mut recorder,
         &full,
         topics::GAUGE_COMPARISON,
         topics::OUTPUT_QOS,
     )?;
-    let clock_out = outlet::<Clock>(
-        &mut node,
-        &ros,
-        &mut recorder,
-        &full,
-        topics::CLOCK,
-        topics::STREAM_QOS,
-    )?;
+    // On simulated time the player owns /clock.
+    let clock_out = if settings.use_sim_time {
+        None
+    } else {
+        Some(outlet::<Clock>(
+            &mut node,
+            &mut recorder,
+            &full,
+            topics::CLOCK,
+            topics::STREAM_QOS,
+        )?)
+    };
     let diag_out = outlet::<DiagnosticArray>(
         &mut node,
-        &ros,
         &mut recorder,
         &full,
         topics::DIAGNOSTICS,
@@ -444,7 +459,6 @@ async fn serve(
     )?;
     let cloud_out = outlet::<PointCloud2>(
         &mut node,
-        &ros,
         &mut recorder,
         &full,
         topics::PARTICLES,
@@ -452,7 +466,6 @@ async fn serve(
     )?;
     let marker_out = outlet::<MarkerArray>(
         &mut node,
-        &ros,
         &mut recorder,
         &full,
         topics::BED_MARKER,
@@ -520,6 +533,14 @@ async fn serve(
         })));
     }
     let mut sensor_stream = futures::stream::select_all(streams);
+    let mut clock_stream: std::pin::Pin<Box<dyn futures::Stream<Item = _> + Send>> =
+        match &clock_sub {
+            Some(sub) => Box::pin(sub.async_stream()),
+            None => Box::pin(futures::stream::pending()),
+        };
+    let mut clock = NodeClock::new(settings.use_sim_time);
+    let mut before_clock = 0u64;
+    let mut sim_time_change_said = false;
     // With no sensor on the network, a recorded session plays the sensors' part.
     let heard_sensor = Arc::new(AtomicBool::new(false));
     let (fallback_tx, mut fallback_rx) = tokio::sync::mpsc::channel::<Sample>(64);
@@ -527,6 +548,12 @@ async fn serve(
         .replay_when_silent
         .clone()
         .filter(|_| !args.no_replay)
+        .filter(|_| {
+            if settings.use_sim_time {
+                println!("use_sim_time: the twin waits for /clock and its sensors");
+            }
+            !settings.use_sim_time
+        })
         .filter(|path| {
             let exists = path.exists();
             if !exists {
@@ -589,7 +616,10 @@ async fn serve(
                         println!("sensors heard on {topic}");
                     }
                     recorder.input(&sample);
-                    take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now_s());
+                    match clock.now() {
+                        Some(now) => take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now),
+                        None => refuse_before_clock(&topic, &mut before_clock),
+                    }
                 }
                 Err(e) => {
                     undecodable += 1;
@@ -598,8 +628,14 @@ async fn serve(
             },
             Some(sample) = fallback_rx.recv() => {
                 recorder.input(&sample);
-                take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now_s());
+                if let Some(now) = clock.now() {
+                    take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now);
+                }
             }
+            Some(r) = clock_stream.next() => match r {
+                Ok((c, _)) => clock.set(c.clock.as_secs_f64()),
+                Err(e) => log::warn!("/clock: a message could not be read: {e:?}"),
+            },
             Some(report) = reports.recv() => {
                 outstanding = outstanding.saturating_sub(1);
                 let report: Report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
@@ -613,10 +649,12 @@ async fn serve(
                 solver_refused += report.refused_inflows;
                 (frames_sent, frames_skipped) = (report.frames_sent, report.frames_skipped);
                 period.add(&report);
-                let origin = pacer.origin().unwrap_or_else(now_s);
+                let origin = pacer.origin().or(clock.now()).unwrap_or(0.0);
                 let stamp = Time::from_secs_f64(origin + sim_t).unwrap_or_default();
                 let header = Header { stamp, frame_id: settings.frame_id.clone() };
-                clock_out.send(&mut recorder, Clock { clock: stamp }).await;
+                if let Some(out) = &clock_out {
+                    out.send(&mut recorder, Clock { clock: stamp }).await;
+                }
                 if let Some(points) = &report.cloud {
                     let cloud = visual::point_cloud(header.clone(), points, args.cloud_max_points);
                     cloud_out.send(&mut recorder, cloud).await;
@@ -629,10 +667,13 @@ async fn serve(
                 if due || last {
                     last_publish = Some(Instant::now());
                     published_outputs += 1;
-                    let now = now_s();
+                    let now = clock.now();
                     let stale: Vec<bool> = measured
                         .iter()
-                        .map(|m| m.newest().is_none_or(|t| now - t > settings.stale_after_s))
+                        .map(|m| match (m.newest(), now) {
+                            (Some(t), Some(now)) => now - t > settings.stale_after_s,
+                            _ => true,
+                        })
                         .collect();
                     // Each gauge against its reading at the output's own time.
                     let at: Vec<Option<f64>> =
@@ -664,8 +705,8 @@ async fn serve(
                 }
                 pacer.stale_after_s = now_live.stale_after_s;
                 settings = now_live;
-                if outstanding == 0 && !paused {
-                    let now = now_s();
+                // Simulated time that has not started holds the twin.
+                if let (0, false, Some(now)) = (outstanding, paused, clock.now()) {
                     let mut cap = args.max_chunk_s;
                     if let Some(u) = until {
                         cap = cap.min(u - sim_t);
@@ -723,14 +764,25 @@ async fn serve(
                 }
             }
             _ = diag_tick.tick() => {
-                let now = now_s();
+                let now = clock.now();
                 let stale: Vec<&str> = gauge_names
                     .iter()
                     .zip(&measured)
-                    .filter(|(_, m)| m.newest().is_none_or(|t| now - t > settings.stale_after_s))
+                    .filter(|(_, m)| match (m.newest(), now) {
+                        (Some(t), Some(now)) => now - t > settings.stale_after_s,
+                        _ => true,
+                    })
                     .map(|(n, _)| n.as_str())
                     .collect();
-                let lag = pacer.lag(sim_t, now);
+                let lag = now.map_or(0.0, |now| pacer.lag(sim_t, now));
+                let asked = node.get_parameter("use_sim_time");
+                if asked.is_some_and(|v| v != ParameterValue::Boolean(settings.use_sim_time))
+                    && !std::mem::replace(&mut sim_time_change_said, true)
+                {
+                    log::warn!(
+                        "use_sim_time was changed on the running node: the twin keeps the clock it started with; restart it to change"
+                    );
+                }
                 let (rtf, step_rate, busy) = period.take(sim_t);
                 diag_count += 1;
                 // A line on the terminal every ten seconds, for whoever started the twin by hand.
@@ -755,7 +807,9 @@ async fn serve(
                     ("particles", particles.to_string()),
                     ("adapter", adapter.clone()),
                     ("solver_busy_fraction", format!("{busy:.3}")),
-                    ("sensor_driven", pacer.sensor_driven(now).to_string()),
+                    ("sensor_driven", now.is_some_and(|now| pacer.sensor_driven(now)).to_string()),
+                    ("clock", if clock.simulated() { "/clock" } else { "system" }.to_string()),
+                    ("inputs_before_clock", before_clock.to_string()),
                     ("paused", paused.to_string()),
                     ("stale_sensors", stale.join(",")),
                     ("rejected_inputs", gate.refused_total().to_string()),
@@ -782,7 +836,7 @@ async fn serve(
                     (false, false) => format!("stale sensors: {}", stale.join(", ")),
                     (false, true) => "running".to_string(),
                 };
-                let stamp = Time::from_secs_f64(now).unwrap_or_default();
+                let stamp = Time::from_secs_f64(now.unwrap_or(0.0)).unwrap_or_default();
                 diag_out.send(&mut recorder, DiagnosticArray {
                     header: Header { stamp, frame_id: String::new() },
                     status: vec![DiagnosticStatus {
@@ -829,6 +883,16 @@ fn take(
             measured[index].push(stamp_s, level_m);
         }
         None => {}
+    }
+}
+
+/// A sample that came before simulated time started: nothing can judge its stamp yet.
+fn refuse_before_clock(topic: &str, count: &mut u64) {
+    *count += 1;
+    if *count == 1 {
+        log::warn!(
+            "{topic}: a sample came before the first /clock message (use_sim_time): refused, as are any more until /clock starts (counted in /diagnostics)"
+        );
     }
 }
 
@@ -892,7 +956,7 @@ async fn play_when_silent(
         path.display(),
         samples.len()
     );
-    let start = now_s();
+    let start = crate::clock::system_s();
     let started = Instant::now();
     for (_, mut sample) in samples {
         let offset = sample.stamp().as_secs_f64() - first;

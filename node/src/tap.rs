@@ -52,7 +52,7 @@ impl Tap {
     }
 
     pub fn input(&mut self, sample: &Sample) {
-        let now = nanos(crate::run::now_s());
+        let now = nanos(crate::clock::system_s());
         let sent = sample.stamp().as_nanos().unwrap_or(now);
         let (k, result) = match sample {
             Sample::Inflow(m) => (0, self.write_to(0, m, now, sent)),
@@ -75,7 +75,7 @@ impl Tap {
         let (Some(bag), Some(ch)) = (self.bag.as_mut(), channel) else {
             return;
         };
-        let now = nanos(crate::run::now_s());
+        let now = nanos(crate::clock::system_s());
         if let Err(e) = bag.write(ch, msg, now, now) {
             self.stop(&format!("{e:#}"));
         }

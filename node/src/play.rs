@@ -1,0 +1,245 @@
+//! `flume-twin replay REC.mcap --publish`: a recorded session's sensor topics played on the
+//! wire (ROS 2 over DDS) with `/clock`, as `ros2 bag play --clock` does, for a twin (or any
+//! ROS node) running on simulated time (`use_sim_time:=true`) elsewhere.
+//!
+//! Samples go out unchanged (their stamps are the recording's) when the player's clock
+//! reaches their log time; `/clock` carries that clock `--clock-hz` times a wall second, and
+//! holds at the start for `--delay-s` so that subscribers match before the first sample. The
+//! topics' QoS is the twin's table's (`topics.rs`), which is what our recordings offer.
+
+use crate::bag::{Recorded, Recording};
+use crate::cli::ReplayArgs;
+use crate::ros_args::RosArgs;
+use crate::run::{dds_context, full_topic, qos, topic_name, type_name};
+use crate::topics;
+use anyhow::{Context as _, Result, anyhow, bail};
+use flume_msgs::RosMessage;
+use flume_msgs::builtin_interfaces::Time;
+use flume_msgs::flume_msgs::{Discharge, WaterLevel};
+use flume_msgs::rosgraph_msgs::Clock;
+use flume_msgs::sensor_msgs::Range;
+use ros2_client::{Node, NodeName, NodeOptions, Publisher};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// A sensor topic's publisher.
+enum Wire {
+    Inflow(Publisher<Discharge>),
+    Level(Publisher<WaterLevel>),
+    Range(Publisher<Range>),
+}
+
+/// A sample to play: its publisher (by index), its log time (s) and the message.
+enum Payload {
+    Inflow(Discharge),
+    Level(WaterLevel),
+    Range(Range),
+}
+
+struct Due {
+    wire: usize,
+    at_s: f64,
+    payload: Payload,
+}
+
+fn publisher<M: RosMessage + Serialize>(
+    node: &mut Node,
+    ros: &RosArgs,
+    topic: &str,
+    topic_qos: crate::bag::TopicQos,
+) -> Result<Publisher<M>> {
+    let q = qos(topic_qos);
+    let t = node
+        .create_topic(
+            &topic_name(&full_topic("/", ros, topic))?,
+            type_name(M::DEF),
+            &q,
+        )
+        .with_context(|| format!("cannot create topic {topic}"))?;
+    node.create_publisher::<M>(&t, Some(q))
+        .with_context(|| format!("cannot publish {topic}"))
+}
+
+/// What the player plays of `m`: its payload, or None for a topic that is no sensor's.
+fn payload(m: &Recorded) -> Option<Result<Payload>> {
+    let s = m.schema_name.as_str();
+    if s == Discharge::DEF.schema_name() {
+        Some(m.decode().map(Payload::Inflow))
+    } else if s == WaterLevel::DEF.schema_name() {
+        Some(m.decode().map(Payload::Level))
+    } else if s == Range::DEF.schema_name() {
+        Some(m.decode().map(Payload::Range))
+    } else {
+        None
+    }
+}
+
+pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
+    let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
+    let recording = Recording::read(&args.recording)?;
+    if let Some(damage) = &recording.damage {
+        log::warn!("{damage}; playing what comes before it");
+        eprintln!("warning: {damage}; playing what comes before it");
+    }
+    let selected = |topic: &str| args.topics.is_empty() || args.topics.iter().any(|t| t == topic);
+    let mut sensors: Vec<&Recorded> = Vec::new();
+    let mut ignored: BTreeMap<&str, u64> = BTreeMap::new();
+    for m in &recording.messages {
+        match payload(m).filter(|_| selected(&m.topic)) {
+            Some(_) => sensors.push(m),
+            None => *ignored.entry(&m.topic).or_default() += 1,
+        }
+    }
+    for (topic, n) in &ignored {
+        println!("not played: {topic} ({n} messages)");
+    }
+    sensors.sort_by_key(|m| m.log_ns);
+    let Some(first) = sensors.first() else {
+        bail!(
+            "{} holds no inflow or gauge topic to play",
+            args.recording.display()
+        );
+    };
+    let start_s = first.log_ns as f64 * 1e-9 + args.start_s;
+    let end_s = args.until.map_or(f64::INFINITY, |u| start_s + u);
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .context("cannot start the async runtime")?;
+    runtime.block_on(async {
+        let context = dds_context(args.loopback, args.domain_id)?;
+        let mut node = context
+            .new_node(
+                NodeName::new("/", "flume_twin_player")
+                    .map_err(|e| anyhow!("node name: {e}"))?,
+                NodeOptions::new(),
+            )
+            .context("cannot create the ROS 2 node")?;
+        tokio::spawn(node.spinner().context("cannot spin the node")?.spin());
+        let clock = publisher::<Clock>(&mut node, &ros, topics::CLOCK, topics::STREAM_QOS)?;
+        let mut wires: Vec<Wire> = Vec::new();
+        let mut index: BTreeMap<&str, usize> = BTreeMap::new();
+        let mut plan: Vec<Due> = Vec::new();
+        let mut undecodable = 0u64;
+        for m in sensors {
+            let at_s = m.log_ns as f64 * 1e-9;
+            if at_s < start_s || at_s > end_s {
+                continue;
+            }
+            let payload = match payload(m) {
+                Some(Ok(p)) => p,
+                Some(Err(e)) => {
+                    undecodable += 1;
+                    log::warn!("{e:#}");
+                    continue;
+                }
+                None => continue,
+            };
+            let wire = match index.get(m.topic.as_str()) {
+                Some(&k) => k,
+                None => {
+                    let (t, q) = (m.topic.as_str(), &m.topic);
+                    wires.push(match payload {
+                        Payload::Inflow(_) => Wire::Inflow(publisher(
+                            &mut node,
+                            &ros,
+                            t,
+                            topics::INFLOW_QOS,
+                        )?),
+                        Payload::Level(_) => {
+                            Wire::Level(publisher(&mut node, &ros, t, topics::GAUGE_QOS)?)
+                        }
+                        Payload::Range(_) => {
+                            Wire::Range(publisher(&mut node, &ros, t, topics::GAUGE_QOS)?)
+                        }
+                    });
+                    println!("playing {q} as {}", full_topic("/", &ros, q));
+                    index.insert(t, wires.len() - 1);
+                    wires.len() - 1
+                }
+            };
+            plan.push(Due {
+                wire,
+                at_s,
+                payload,
+            });
+        }
+        let rate = args.rate.unwrap_or(1.0);
+        let last_s = plan.last().map_or(start_s, |d| d.at_s);
+        println!(
+            "playing {} samples on {} topics, {:.1} s of the recording from {start_s:.3} s since the epoch, at {rate} x, /clock at {} Hz",
+            plan.len(),
+            wires.len(),
+            last_s - start_s,
+            args.clock_hz,
+        );
+        let send_clock = |t: f64| {
+            let stamp = Time::from_secs_f64(t).unwrap_or_default();
+            if let Err(e) = clock.publish(Clock { clock: stamp }) {
+                log::warn!("/clock could not be sent: {e:?}");
+            }
+        };
+        let period = Duration::from_secs_f64(1.0 / args.clock_hz);
+        let mut shutdown = Box::pin(tokio::signal::ctrl_c());
+        let mut terminate =
+            tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+                .context("cannot watch for SIGTERM")?;
+        let held = Instant::now();
+        while held.elapsed().as_secs_f64() < args.delay_s.max(0.0) {
+            send_clock(start_s);
+            tokio::select! {
+                _ = tokio::time::sleep(period) => {}
+                _ = &mut shutdown => return Ok(()),
+                _ = terminate.recv() => return Ok(()),
+            }
+        }
+        let started = Instant::now();
+        let mut next_clock = started;
+        let (mut sent, mut clocks) = (0usize, 0u64);
+        while sent < plan.len() {
+            let now_s = start_s + started.elapsed().as_secs_f64() * rate;
+            if Instant::now() >= next_clock {
+                send_clock(now_s.min(last_s));
+                clocks += 1;
+                next_clock += period;
+            }
+            while let Some(d) = plan.get(sent).filter(|d| d.at_s <= now_s) {
+                let r = match (&wires[d.wire], &d.payload) {
+                    (Wire::Inflow(p), Payload::Inflow(m)) => p.publish(m.clone()).map_err(drop),
+                    (Wire::Level(p), Payload::Level(m)) => p.publish(m.clone()).map_err(drop),
+                    (Wire::Range(p), Payload::Range(m)) => p.publish(m.clone()).map_err(drop),
+                    _ => Err(()),
+                };
+                if r.is_err() {
+                    log::warn!("a sample logged at {:.3} s could not be sent", d.at_s);
+                }
+                sent += 1;
+            }
+            let next_sample = plan.get(sent).map_or(next_clock, |d| {
+                started + Duration::from_secs_f64((d.at_s - start_s) / rate)
+            });
+            tokio::select! {
+                _ = tokio::time::sleep_until(next_clock.min(next_sample).into()) => {}
+                _ = &mut shutdown => {
+                    println!("interrupted at {:.3} s of the recording", now_s - start_s);
+                    return Ok(());
+                }
+                _ = terminate.recv() => {
+                    println!("terminated at {:.3} s of the recording", now_s - start_s);
+                    return Ok(());
+                }
+            }
+        }
+        send_clock(last_s);
+        // Reliable samples still in flight get their chance before the writers go.
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        println!(
+            "played {sent} samples and {} /clock messages in {:.1} s; undecodable: {undecodable}",
+            clocks + 1,
+            started.elapsed().as_secs_f64()
+        );
+        Ok(())
+    })
+}

@@ -1,0 +1,293 @@
+//! `replay --publish`: the bundled session played on the wire with /clock, as `ros2 bag play
+//! --clock` does, to a twin on simulated time (`use_sim_time:=true`) in another process, with a
+//! Cyclone DDS listener (`tests/interop/dds_listen.py`, a DDS nobody here wrote) checking what
+//! went on the wire against the recording itself.
+
+mod common;
+
+use common::{ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
+use serde_json::Value;
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// The player's and the twin's DDS domain, away from the other tests' traffic.
+const DOMAIN: &str = "7";
+/// Recorded seconds played, and how fast.
+const PLAYED_S: f64 = 6.0;
+const RATE: f64 = 2.0;
+
+fn stamp(v: &Value) -> f64 {
+    v["sec"].as_f64().expect("sec") + v["nanosec"].as_f64().expect("nanosec") * 1e-9
+}
+
+/// Waits for `child` at most `limit`; kills it past that (a hung twin fails the test rather
+/// than CI).
+fn finish(mut child: Child, limit: Duration, what: &str) -> Output {
+    let start = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("output");
+            panic!("{what} ran past {limit:?}:\n{}", printed(&out));
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.wait_with_output().expect("output")
+}
+
+#[test]
+fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
+    let Some(_gpu) = gpu() else { return };
+    if !python_has(
+        "cyclonedds, mcap, mcap_ros2",
+        "cyclonedds mcap mcap-ros2-support",
+    ) {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("flume-play-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let session = repo_file("tests/data/ulbra_session.mcap");
+    let sensors = ["/inflow", "/gauges/p1", "/gauges/p2", "/gauges/p3"];
+    let recorded = read_mcap(&session, &sensors);
+    let recorded = recorded["messages"].as_array().expect("messages");
+    let t0 = recorded
+        .iter()
+        .map(|m| m["log_time"].as_f64().expect("log time") * 1e-9)
+        .fold(f64::INFINITY, f64::min);
+    let played: Vec<&Value> = recorded
+        .iter()
+        .filter(|m| m["log_time"].as_f64().expect("log time") * 1e-9 <= t0 + PLAYED_S)
+        .collect();
+    let on = |topic: &str| -> Vec<(f64, f64)> {
+        played
+            .iter()
+            .filter(|m| m["topic"] == topic)
+            .map(|m| {
+                let v = &m["msg"];
+                let x = v.get("discharge_m3_per_s").unwrap_or(&v["level_m"]);
+                (stamp(&v["header"]["stamp"]), x.as_f64().expect("value"))
+            })
+            .collect()
+    };
+
+    // The twin first, in the root namespace where the recording's topics are.
+    let twin_rec = dir.join("twin.mcap");
+    let mut twin = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+        .arg("run")
+        .arg(repo_file("launch_configs/ulbra_flume.yaml"))
+        .args(ULBRA_CI)
+        .args(["--loopback", "--domain-id", DOMAIN, "--no-frames"])
+        .args(["--until", "0.3", "--record"])
+        .arg(&twin_rec)
+        .args(["--ros-args", "-p", "use_sim_time:=true"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the twin starts");
+    let mut twin_lines = BufReader::new(twin.stdout.take().expect("stdout")).lines();
+    let mut twin_said = Vec::new();
+    for line in twin_lines.by_ref() {
+        let line = line.expect("the twin's output");
+        let started = line.starts_with("node:");
+        twin_said.push(line);
+        if started {
+            break;
+        }
+    }
+    let twin_out = std::thread::spawn(move || {
+        twin_said.extend(twin_lines.map_while(Result::ok));
+        twin_said.join("\n")
+    });
+    let listener = Command::new("python3")
+        .arg(repo_file("tests/interop/dds_listen.py"))
+        .args([DOMAIN, "/", "120", "5"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the listener starts");
+    // Both have joined the domain before the player's first sample: /clock holds for
+    // --delay-s first.
+    std::thread::sleep(Duration::from_secs(3));
+    let player = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+        .arg("replay")
+        .arg(&session)
+        .args(["--publish", "--loopback", "--domain-id", DOMAIN])
+        .args([
+            "--until",
+            &PLAYED_S.to_string(),
+            "--rate",
+            &RATE.to_string(),
+        ])
+        .args(["--delay-s", "2"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the player starts");
+    let player = finish(player, Duration::from_secs(60), "the player");
+    let player_log = printed(&player);
+    assert!(player.status.success(), "the player failed:\n{player_log}");
+    let twin = finish(twin, Duration::from_secs(600), "the twin");
+    let twin_log = twin_out.join().expect("the twin's output") + &printed(&twin);
+    assert!(twin.status.success(), "the twin failed:\n{twin_log}");
+    let listener = finish(listener, Duration::from_secs(150), "the listener");
+    let heard = printed(&listener);
+    assert!(
+        !heard.contains("Traceback"),
+        "the listener failed:\n{heard}"
+    );
+
+    // The player: every sample of the window, paced: PLAYED_S recorded seconds at RATE take
+    // at least PLAYED_S / RATE wall seconds (a lower bound, which no slow machine breaks).
+    let line = player_log
+        .lines()
+        .find(|l| l.starts_with("played "))
+        .unwrap_or_else(|| panic!("no summary:\n{player_log}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    assert_eq!(words[1].parse::<usize>().ok(), Some(played.len()), "{line}");
+    let wall: f64 = words[words.iter().position(|w| *w == "in").expect("in") + 1]
+        .parse()
+        .expect("seconds");
+    assert!(wall >= PLAYED_S / RATE, "{line}");
+
+    // The wire, as Cyclone DDS read it: /clock on the recording's time, only the player's
+    // (a twin on simulated time publishes none), from the start to the end of the window;
+    // the inflow (reliable) sample for sample as recorded, stamps unchanged; the gauges (best
+    // effort) each as recorded.
+    let lines: Vec<Value> = heard
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect();
+    let clocks: Vec<f64> = lines.iter().filter_map(|v| v["clock"].as_f64()).collect();
+    assert!(clocks.len() > 10, "{} /clock messages", clocks.len());
+    // 1 µs: the clock's nanoseconds against a float of seconds since the epoch.
+    assert!(
+        (clocks[0] - t0).abs() < 1e-6,
+        "first /clock {} vs {t0}",
+        clocks[0]
+    );
+    assert!(clocks.windows(2).all(|w| w[1] >= w[0]), "/clock went back");
+    let last = clocks.last().copied().unwrap_or(0.0);
+    assert!(
+        last <= t0 + PLAYED_S + 1e-6 && last >= t0 + PLAYED_S - 0.1,
+        "last /clock {:.3} s into the recording",
+        last - t0
+    );
+    let got = |name: &str| -> Vec<(f64, f64)> {
+        lines
+            .iter()
+            .filter_map(|v| v.get(name))
+            .map(|v| {
+                let x = v.get("q").unwrap_or(&v["level"]);
+                (
+                    v["stamp"].as_f64().expect("stamp"),
+                    x.as_f64().expect("value"),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(got("inflow"), on("/inflow"), "the inflow on the wire");
+    for g in ["p1", "p2", "p3"] {
+        let (sent, heard) = (on(&format!("/gauges/{g}")), got(g));
+        assert!(
+            heard.iter().all(|s| sent.contains(s)),
+            "{g}: a sample that is not the recording's"
+        );
+        // Best effort over loopback loses little; 90 % leaves room for a loaded machine.
+        assert!(
+            heard.len() * 10 >= sent.len() * 9,
+            "{g}: {} of {} samples heard",
+            heard.len(),
+            sent.len()
+        );
+    }
+
+    // The twin followed the player's clock: its outputs are stamped on the recording's time
+    // and compare with gauges that are not stale on that clock.
+    assert!(twin_log.contains("simulated time started at"), "{twin_log}");
+    assert!(twin_log.contains("reached t = 0.300 s"), "{twin_log}");
+    let out = read_mcap(&twin_rec, &["/gauges/predicted", "/inflow"]);
+    assert!(
+        out["channels"].get("/clock").is_none(),
+        "a twin on simulated time publishes no /clock"
+    );
+    let messages = out["messages"].as_array().expect("messages");
+    let inflow_in: Vec<f64> = messages
+        .iter()
+        .filter(|m| m["topic"] == "/inflow")
+        .map(|m| stamp(&m["msg"]["header"]["stamp"]))
+        .collect();
+    assert!(!inflow_in.is_empty(), "the twin took no inflow");
+    assert!(
+        inflow_in
+            .iter()
+            .all(|s| on("/inflow").iter().any(|(t, _)| t == s)),
+        "the twin's inputs are the recording's samples"
+    );
+    let predicted: Vec<&Value> = messages
+        .iter()
+        .filter(|m| m["topic"] == "/gauges/predicted")
+        .map(|m| &m["msg"])
+        .collect();
+    assert!(!predicted.is_empty());
+    for p in &predicted {
+        let s = stamp(&p["header"]["stamp"]);
+        // The outputs' stamps are the first sample heard plus simulated time (to 0.3 s); the
+        // first heard may be a gauge's, a few ms after the inflow's (50 ms: half a gauge's
+        // period).
+        assert!(
+            s >= t0 - 1e-3 && s <= t0 + 0.3 + 0.05,
+            "an output stamped {:.4} s from the recording's start",
+            s - t0
+        );
+    }
+    let final_gauges = predicted.last().expect("an output")["gauges"]
+        .as_array()
+        .expect("gauges");
+    for g in final_gauges {
+        assert!(g["measured_m"].as_f64().is_some(), "{g}");
+        assert_eq!(g["stale"], false, "{g}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn publish_takes_no_twin_options() {
+    for extra in [
+        vec!["--config", "launch_configs/ulbra_flume.yaml"],
+        vec!["--out", "x.mcap"],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .arg("replay")
+            .arg(repo_file("tests/data/ulbra_session.mcap"))
+            .arg("--publish")
+            .args(&extra)
+            .output()
+            .expect("runs");
+        assert!(!out.status.success(), "{extra:?} was taken");
+        assert!(
+            printed(&out).contains("cannot be used with"),
+            "{}",
+            printed(&out)
+        );
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+        .arg("replay")
+        .arg(repo_file("tests/data/ulbra_session.mcap"))
+        .args([
+            "--config",
+            "launch_configs/ulbra_flume.yaml",
+            "--ros-args",
+            "-r",
+            "a:=b",
+        ])
+        .output()
+        .expect("runs");
+    assert!(!out.status.success());
+    assert!(
+        printed(&out).contains("--ros-args is for --publish"),
+        "{}",
+        printed(&out)
+    );
+}
