@@ -48,6 +48,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             args.steps_seconds
         );
     }
+    if args.frames {
+        return crate::frames_bench::run(&args.flume, args.steps_seconds);
+    }
     if let Some(n) = args.ladder.iter().find(|n| **n < 100) {
         bail!("--ladder: {n} particles is too few for a dam break; use at least 100");
     }

@@ -266,6 +266,10 @@ pub struct BenchArgs {
         default_value = "launch_configs/ulbra_flume.yaml"
     )]
     pub flume: PathBuf,
+    /// Time the particle frames over iceoryx2 instead (at the --flume case's particle count:
+    /// frames and bytes per second, and latency).
+    #[arg(long)]
+    pub frames: bool,
     /// Wall-clock seconds each measurement should last (approximately).
     #[arg(
         long,

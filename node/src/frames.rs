@@ -164,6 +164,12 @@ impl Frames {
     }
 
     fn send(&mut self, sim: &Simulation) -> Result<()> {
+        self.fill(sim)?;
+        self.publish(sim.steps(), sim.time_s())
+    }
+
+    /// Takes `sim`'s particles into the frame buffer.
+    pub fn fill(&mut self, sim: &Simulation) -> Result<()> {
         let p = sim
             .read_particles()
             .context("cannot read the particles back")?;
@@ -189,6 +195,11 @@ impl Frames {
                 reserved: 0,
             }
         }));
+        Ok(())
+    }
+
+    /// Sends the frame buffer, stamped `step` and `sim_time_s`, and wakes the readers.
+    pub fn publish(&mut self, step: u64, sim_time_s: f64) -> Result<()> {
         let sample = self
             .publisher
             .loan_slice_uninit(self.buffer.len())
@@ -198,8 +209,8 @@ impl Frames {
             version: FRAME_VERSION,
             parked_phase: self.parked_phase,
             count: self.buffer.len() as u64,
-            step: sim.steps(),
-            sim_time_s: sim.time_s(),
+            step,
+            sim_time_s,
             sent_unix_ns: 0,
             units: *UNITS,
         };

@@ -8,6 +8,7 @@ mod bench;
 mod cli;
 mod clock;
 mod frames;
+mod frames_bench;
 mod inflow;
 mod inputs;
 mod observed;
