@@ -11,6 +11,7 @@ use crate::bag::{BagWriter, Recorded, Recording};
 use crate::cli::ReplayArgs;
 use crate::inputs::{self, InputGate, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
+use crate::ros_args::RosArgs;
 use crate::samples::{Admitted, Input, decode, role};
 use crate::solver_thread::{self, Command};
 use crate::topics;
@@ -108,14 +109,43 @@ impl Outputs {
     }
 }
 
+/// The height of each gauge's range sensor above the floor: the live twin's parameters
+/// `gauge_mount_height_m.<gauge>` from `--ros-args -p` or `--params-file`, else the flume's
+/// top. The node's other parameters mean nothing to an in-process replay and are ignored.
+fn mount_heights(ros: &RosArgs, gauges: &[String], flume_top_m: f64) -> Result<Vec<f64>> {
+    let node = format!(
+        "{}/{}",
+        ros.namespace
+            .as_deref()
+            .unwrap_or("/")
+            .trim_end_matches('/'),
+        ros.node_name.as_deref().unwrap_or("flume_twin")
+    );
+    let mut heights = vec![flume_top_m; gauges.len()];
+    for (name, value) in ros.parameters(&node)? {
+        let Some(gauge) = name.strip_prefix("gauge_mount_height_m.") else {
+            log::info!("parameter {name} does not apply to a replay: ignored");
+            continue;
+        };
+        // A parameter file may serve cases with more gauges than this one.
+        let Some(k) = gauges.iter().position(|g| g.eq_ignore_ascii_case(gauge)) else {
+            log::warn!("{name}: this case has no gauge {gauge}: ignored");
+            continue;
+        };
+        heights[k] = value
+            .as_f64()
+            .filter(|h| h.is_finite() && *h > 0.0)
+            .ok_or_else(|| anyhow!("{name} must be a positive number, got {value:?}"))?;
+    }
+    Ok(heights)
+}
+
 /// Replays `args.recording` through the twin, or with `--publish` on the wire.
 pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     if args.publish {
         return crate::play::run(args, ros_args);
     }
-    if !ros_args.is_empty() {
-        bail!("--ros-args is for --publish: an in-process replay has no ROS node");
-    }
+    let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
     let Some(config) = &args.config else {
         bail!("--config CASE is needed to replay through the twin");
     };
@@ -193,11 +223,10 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     let mut inflow: Vec<(f64, f64)> = carried.map(|(_, q)| (0.0, q)).into_iter().collect();
     let mut measured: Vec<Readings> = vec![Readings::default(); gauge_names.len()];
     let mut fed: Vec<usize> = Vec::new();
-    let mount_height_m = vec![limits.flume_height_m; gauge_names.len()];
+    let mount_height_m = mount_heights(&ros, &gauge_names, limits.flume_height_m)?;
     for &(k, input) in &events {
         let now = feed[k].0.log_ns as f64 * 1e-9;
         fed.push(k);
-        // A replayed range sensor is taken as mounted at the flume's top.
         match input.admit(&mut gate, &gauge_names, &mount_height_m, now) {
             Some(Admitted::Inflow { stamp_s, q }) => inflow.push((stamp_s - origin, q)),
             Some(Admitted::Level {
@@ -318,4 +347,58 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         }
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn heights(args: &[&str]) -> Result<Vec<f64>> {
+        let gauges = ["P1".to_string(), "P2".to_string()];
+        mount_heights(&RosArgs::parse(args).expect("parses"), &gauges, 0.3)
+    }
+
+    #[test]
+    fn range_gauges_take_the_live_twin_s_mount_heights() {
+        assert_eq!(heights(&[]).expect("defaults"), vec![0.3, 0.3]);
+        assert_eq!(
+            heights(&[
+                "-p",
+                "gauge_mount_height_m.p2:=0.25",
+                "-p",
+                "publish_rate_hz:=4.0"
+            ])
+            .expect("p2 set, the rest ignored"),
+            vec![0.3, 0.25]
+        );
+        let file = std::env::temp_dir().join(format!("mounts-{}.yaml", std::process::id()));
+        std::fs::write(
+            &file,
+            "/flume/flume_twin:\n  ros__parameters:\n    gauge_mount_height_m:\n      p1: 0.22\n",
+        )
+        .expect("writes");
+        let path = file.to_str().expect("utf-8");
+        let h = heights(&["--params-file", path, "-r", "__ns:=/flume"]).expect("the file");
+        assert_eq!(
+            h,
+            vec![0.22, 0.3],
+            "the file's entry for the twin under /flume"
+        );
+        let h = heights(&["--params-file", path]).expect("the file");
+        assert_eq!(
+            h,
+            vec![0.3, 0.3],
+            "an entry for another node's name does not apply"
+        );
+        let _ = std::fs::remove_file(&file);
+        assert_eq!(
+            heights(&["-p", "gauge_mount_height_m.p9:=0.2"]).expect("p9 ignored"),
+            vec![0.3, 0.3]
+        );
+        let err = heights(&["-p", "gauge_mount_height_m.p1:=-0.2"]).expect_err("refused");
+        assert!(
+            err.to_string().contains("must be a positive number"),
+            "{err}"
+        );
+    }
 }

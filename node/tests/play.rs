@@ -253,7 +253,7 @@ fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
 }
 
 #[test]
-fn publish_takes_no_twin_options() {
+fn publish_takes_no_twin_options_and_a_replay_checks_its_mounts() {
     for extra in [
         vec!["--config", "launch_configs/ulbra_flume.yaml"],
         vec!["--out", "x.mcap"],
@@ -272,21 +272,18 @@ fn publish_takes_no_twin_options() {
             printed(&out)
         );
     }
+    // An in-process replay takes the live twin's range-sensor mounts, validated as it does.
     let out = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
         .arg("replay")
         .arg(repo_file("tests/data/ulbra_session.mcap"))
-        .args([
-            "--config",
-            "launch_configs/ulbra_flume.yaml",
-            "--ros-args",
-            "-r",
-            "a:=b",
-        ])
+        .arg("--config")
+        .arg(repo_file("launch_configs/ulbra_flume.yaml"))
+        .args(["--ros-args", "-p", "gauge_mount_height_m.p1:=-0.2"])
         .output()
         .expect("runs");
     assert!(!out.status.success());
     assert!(
-        printed(&out).contains("--ros-args is for --publish"),
+        printed(&out).contains("gauge_mount_height_m.p1 must be a positive number"),
         "{}",
         printed(&out)
     );
