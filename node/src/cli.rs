@@ -114,6 +114,15 @@ pub enum GaugeMsg {
     Range,
 }
 
+/// A parser of numbers from `lo` to `hi`, both included.
+fn within(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
+    move |s| match s.parse::<f64>() {
+        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+        Ok(v) => Err(format!("must be from {lo} to {hi}, got {v}")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 fn positive(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
@@ -170,9 +179,9 @@ pub struct ReplayArgs {
     /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk.
     #[arg(long, value_name = "DIR", conflicts_with = "publish")]
     pub csv: Option<PathBuf>,
-    /// Pace the replay at this many recorded seconds per wall second [default: as fast as
-    /// the adapter goes; 1 with --publish].
-    #[arg(long, value_name = "X", value_parser = positive)]
+    /// Pace the replay at this many recorded seconds per wall second, 0.001 to 1000 [default:
+    /// as fast as the adapter goes; 1 with --publish].
+    #[arg(long, value_name = "X", value_parser = within(1e-3, 1e3))]
     pub rate: Option<f64>,
     /// Play the sensor topics on the wire (ROS 2 over DDS) with /clock on the recording's
     /// time, as `ros2 bag play --clock` does, instead of feeding a twin in-process; a twin
@@ -180,37 +189,43 @@ pub struct ReplayArgs {
     /// recorded names; `--ros-args -r FROM:=TO` renames them.
     #[arg(long)]
     pub publish: bool,
-    /// /clock messages per wall second (with --publish).
-    #[arg(long, value_name = "HZ", default_value_t = 40.0, value_parser = positive)]
+    // The player's options conflict with --config, which only an in-process replay takes:
+    // `requires = "publish"` never fires, as clap counts a flag's default (false) as given.
+    /// /clock messages per wall second, 0.1 to 1000 (with --publish); /clock also goes out
+    /// just before each sample.
+    #[arg(long, value_name = "HZ", default_value_t = 40.0, value_parser = within(0.1, 1e3), conflicts_with = "config")]
     pub clock_hz: f64,
     /// With --publish, /clock holds at the start this long before the first sample goes
-    /// out, so that subscribers have matched, s.
-    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    /// out, so that subscribers have matched, s (at most an hour).
+    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = within(0.0, 3600.0), conflicts_with = "config")]
     pub delay_s: f64,
     /// DDS domain (with --publish).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, conflicts_with = "config")]
     pub domain_id: u16,
     /// With --publish, DDS on the loopback interface only.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "config")]
     pub loopback: bool,
     /// Replay only these recorded topics (comma-separated) [default: every inflow and gauge
     /// topic of the case; with --publish, every inflow and gauge topic].
     #[arg(long, value_name = "T1,T2,...", value_delimiter = ',')]
     pub topics: Vec<String>,
-    /// Start this far into the recording, s; the discharge in force then holds from the start.
-    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    /// Start this far into the recording, s. In-process, the discharge in force then holds
+    /// from the start; with --publish, as `ros2 bag play --start-offset`, nothing before it
+    /// goes out (the twin keeps its discharge until the next inflow sample).
+    #[arg(long, value_name = "S", default_value_t = 0.0, value_parser = within(0.0, 1e9))]
     pub start_s: f64,
-    /// Stop at this simulated time, s [default: the last replayed sample].
+    /// Stop at this simulated time, s, counted from the start (with --publish, recorded
+    /// seconds after the start) [default: the last replayed sample].
     #[arg(long, value_name = "T_S", value_parser = positive)]
     pub until: Option<f64>,
     /// The solver's chunk: outputs are written at multiples of it, s.
     #[arg(long, value_name = "S", default_value_t = 0.1, value_parser = positive, conflicts_with = "publish")]
     pub output_interval_s: f64,
     /// A gauge whose last sample is older than this at an output is flagged stale, s.
-    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = positive)]
+    #[arg(long, value_name = "S", default_value_t = 2.0, value_parser = positive, conflicts_with = "publish")]
     pub stale_after_s: f64,
     /// How far ahead of its logging time a sample's stamp may be, s.
-    #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = positive)]
+    #[arg(long, value_name = "S", default_value_t = 0.5, value_parser = positive, conflicts_with = "publish")]
     pub future_tolerance_s: f64,
 }
 
@@ -268,7 +283,7 @@ pub struct BenchArgs {
     pub flume: PathBuf,
     /// Time the particle frames over iceoryx2 instead (at the --flume case's particle count:
     /// frames and bytes per second, and latency).
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["ladder", "case"])]
     pub frames: bool,
     /// Wall-clock seconds each measurement should last (approximately).
     #[arg(

@@ -40,26 +40,33 @@ impl NodeClock {
         }
     }
 
-    /// A `/clock` message at `t` s. A clock that goes back (a player restarted or looped) is
-    /// followed, as ROS does, and said; a non-finite one is ignored. The system clock ignores
-    /// `/clock`.
-    pub fn set(&mut self, t: f64) {
+    /// A `/clock` message at `t` s; true when it went back (a player restarted or looped),
+    /// which it follows, as ROS does, and says. Time 0 is ROS's "not started" and, like a
+    /// non-finite time, is ignored. The system clock ignores `/clock`.
+    pub fn set(&mut self, t: f64) -> bool {
         let NodeClock::Simulated(latest) = self else {
-            return;
+            return false;
         };
-        if !t.is_finite() {
-            log::warn!("a /clock message with a non-finite time was ignored");
-            return;
+        if !(t.is_finite() && t > 0.0) {
+            log::warn!("a /clock message at {t} s was ignored");
+            return false;
         }
-        match *latest {
-            None => println!("simulated time started at {t:.3} s (use_sim_time)"),
-            Some(previous) if t < previous => log::warn!(
-                "/clock went back {:.3} s, from {previous:.3} to {t:.3}: followed",
-                previous - t
-            ),
-            Some(_) => {}
-        }
+        let back = match *latest {
+            None => {
+                println!("simulated time started at {t:.3} s (use_sim_time)");
+                false
+            }
+            Some(previous) if t < previous => {
+                log::warn!(
+                    "/clock went back {:.3} s, from {previous:.3} to {t:.3}: followed",
+                    previous - t
+                );
+                true
+            }
+            Some(_) => false,
+        };
         *latest = Some(t);
+        back
     }
 }
 
@@ -71,18 +78,21 @@ mod tests {
     fn simulated_time_starts_with_the_first_clock_and_follows_it_back() {
         let mut c = NodeClock::new(true);
         assert_eq!(c.now(), None, "no time before the first /clock");
-        c.set(100.0);
+        assert!(!c.set(0.0));
+        assert_eq!(c.now(), None, "time 0 is ROS's not started");
+        assert!(!c.set(100.0));
         assert_eq!(c.now(), Some(100.0));
-        c.set(f64::NAN);
+        assert!(!c.set(f64::NAN));
         assert_eq!(c.now(), Some(100.0), "a NaN clock is ignored");
-        c.set(90.0);
-        assert_eq!(c.now(), Some(90.0), "a clock that went back is followed");
+        assert!(!c.set(100.5));
+        assert!(c.set(90.0), "a jump back is said");
+        assert_eq!(c.now(), Some(90.0), "and followed");
     }
 
     #[test]
     fn the_system_clock_ignores_clock_messages() {
         let mut c = NodeClock::new(false);
-        c.set(5.0);
+        assert!(!c.set(5.0));
         let now = c.now().expect("the system clock always reads");
         assert!(now > 1.7e9, "seconds since the epoch, got {now}");
     }

@@ -125,7 +125,8 @@ pub fn run(case_path: &std::path::Path, seconds: f64) -> Result<()> {
     }
     let started = Instant::now();
     let (mut sent, mut failed) = (0u64, 0u64);
-    while started.elapsed().as_secs_f64() < seconds {
+    // A reader that failed to open ends at once; its error comes out of `join` below.
+    while started.elapsed().as_secs_f64() < seconds && !reader.is_finished() {
         match frames.publish(sent, 0.0) {
             Ok(()) => sent += 1,
             Err(e) => {

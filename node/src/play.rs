@@ -3,9 +3,11 @@
 //! ROS node) running on simulated time (`use_sim_time:=true`) elsewhere.
 //!
 //! Samples go out unchanged (their stamps are the recording's) when the player's clock
-//! reaches their log time; `/clock` carries that clock `--clock-hz` times a wall second, and
-//! holds at the start for `--delay-s` so that subscribers match before the first sample. The
-//! topics' QoS is the twin's table's (`topics.rs`), which is what our recordings offer.
+//! reaches their log time; `/clock` carries that clock `--clock-hz` times a wall second and
+//! just before each sample (so that a node on simulated time never sees a sample ahead of its
+//! clock by more than the sample's own lead), and holds at the start for `--delay-s` so that
+//! subscribers match before the first sample. The topics' QoS is the twin's table's
+//! (`topics.rs`), which is what our recordings offer.
 
 use crate::bag::{Recorded, Recording};
 use crate::cli::ReplayArgs;
@@ -30,13 +32,14 @@ enum Wire {
     Range(Publisher<Range>),
 }
 
-/// A sample to play: its publisher (by index), its log time (s) and the message.
+/// A sample's message, by type.
 enum Payload {
     Inflow(Discharge),
     Level(WaterLevel),
     Range(Range),
 }
 
+/// A sample to play: its publisher (by index), its log time (s) and the message.
 struct Due {
     wire: usize,
     at_s: f64,
@@ -61,22 +64,36 @@ fn publisher<M: RosMessage + Serialize>(
         .with_context(|| format!("cannot publish {topic}"))
 }
 
-/// What the player plays of `m`: its payload, or None for a topic that is no sensor's.
-fn payload(m: &Recorded) -> Option<Result<Payload>> {
+/// Whether `m` is a sensor's: a discharge, a level or a range.
+fn is_sensor(m: &Recorded) -> bool {
+    [Discharge::DEF, WaterLevel::DEF, Range::DEF]
+        .iter()
+        .any(|d| m.schema_name == d.schema_name())
+}
+
+/// A sensor's message decoded (see [`is_sensor`]).
+fn payload(m: &Recorded) -> Result<Payload> {
     let s = m.schema_name.as_str();
     if s == Discharge::DEF.schema_name() {
-        Some(m.decode().map(Payload::Inflow))
+        m.decode().map(Payload::Inflow)
     } else if s == WaterLevel::DEF.schema_name() {
-        Some(m.decode().map(Payload::Level))
-    } else if s == Range::DEF.schema_name() {
-        Some(m.decode().map(Payload::Range))
+        m.decode().map(Payload::Level)
     } else {
-        None
+        m.decode().map(Payload::Range)
     }
 }
 
 pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
+    if ros.namespace.is_some()
+        || ros.node_name.is_some()
+        || !ros.params.is_empty()
+        || !ros.params_files.is_empty()
+    {
+        log::warn!(
+            "the player takes topic remaps only: its namespace, node name and parameters are ignored"
+        );
+    }
     let recording = Recording::read(&args.recording)?;
     if let Some(damage) = &recording.damage {
         log::warn!("{damage}; playing what comes before it");
@@ -86,9 +103,10 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     let mut sensors: Vec<&Recorded> = Vec::new();
     let mut ignored: BTreeMap<&str, u64> = BTreeMap::new();
     for m in &recording.messages {
-        match payload(m).filter(|_| selected(&m.topic)) {
-            Some(_) => sensors.push(m),
-            None => *ignored.entry(&m.topic).or_default() += 1,
+        if is_sensor(m) && selected(&m.topic) {
+            sensors.push(m);
+        } else {
+            *ignored.entry(&m.topic).or_default() += 1;
         }
     }
     for (topic, n) in &ignored {
@@ -97,8 +115,13 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     sensors.sort_by_key(|m| m.log_ns);
     let Some(first) = sensors.first() else {
         bail!(
-            "{} holds no inflow or gauge topic to play",
-            args.recording.display()
+            "{} holds no inflow or gauge topic to play{}",
+            args.recording.display(),
+            if args.topics.is_empty() {
+                ""
+            } else {
+                " among --topics"
+            }
         );
     };
     let start_s = first.log_ns as f64 * 1e-9 + args.start_s;
@@ -129,18 +152,17 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
                 continue;
             }
             let payload = match payload(m) {
-                Some(Ok(p)) => p,
-                Some(Err(e)) => {
+                Ok(p) => p,
+                Err(e) => {
                     undecodable += 1;
                     log::warn!("{e:#}");
                     continue;
                 }
-                None => continue,
             };
             let wire = match index.get(m.topic.as_str()) {
                 Some(&k) => k,
                 None => {
-                    let (t, q) = (m.topic.as_str(), &m.topic);
+                    let t = m.topic.as_str();
                     wires.push(match payload {
                         Payload::Inflow(_) => Wire::Inflow(publisher(
                             &mut node,
@@ -155,7 +177,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
                             Wire::Range(publisher(&mut node, &ros, t, topics::GAUGE_QOS)?)
                         }
                     });
-                    println!("playing {q} as {}", full_topic("/", &ros, q));
+                    println!("playing {t} as {}", full_topic("/", &ros, t));
                     index.insert(t, wires.len() - 1);
                     wires.len() - 1
                 }
@@ -165,6 +187,13 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
                 at_s,
                 payload,
             });
+        }
+        if plan.is_empty() {
+            bail!(
+                "nothing to play between {} s and {} s into the recording",
+                args.start_s,
+                args.start_s + args.until.unwrap_or(f64::INFINITY)
+            );
         }
         let rate = args.rate.unwrap_or(1.0);
         let last_s = plan.last().map_or(start_s, |d| d.at_s);
@@ -199,18 +228,26 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         let mut next_clock = started;
         let (mut sent, mut clocks) = (0usize, 0u64);
         while sent < plan.len() {
-            let now_s = start_s + started.elapsed().as_secs_f64() * rate;
-            if Instant::now() >= next_clock {
-                send_clock(now_s.min(last_s));
+            let now_s = (start_s + started.elapsed().as_secs_f64() * rate).min(last_s);
+            let due = plan.get(sent).is_some_and(|d| d.at_s <= now_s);
+            if due || Instant::now() >= next_clock {
+                send_clock(now_s);
                 clocks += 1;
-                next_clock += period;
+                // After a stall the clock goes on from now rather than catching up in a burst.
+                next_clock = (next_clock + period).max(Instant::now());
             }
             while let Some(d) = plan.get(sent).filter(|d| d.at_s <= now_s) {
                 let r = match (&wires[d.wire], &d.payload) {
                     (Wire::Inflow(p), Payload::Inflow(m)) => p.publish(m.clone()).map_err(drop),
                     (Wire::Level(p), Payload::Level(m)) => p.publish(m.clone()).map_err(drop),
                     (Wire::Range(p), Payload::Range(m)) => p.publish(m.clone()).map_err(drop),
-                    _ => Err(()),
+                    _ => {
+                        log::warn!(
+                            "a sample logged at {:.3} s has another type than its topic's first: not sent",
+                            d.at_s
+                        );
+                        Ok(())
+                    }
                 };
                 if r.is_err() {
                     log::warn!("a sample logged at {:.3} s could not be sent", d.at_s);
@@ -233,12 +270,12 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
             }
         }
         send_clock(last_s);
+        let wall = started.elapsed().as_secs_f64();
         // Reliable samples still in flight get their chance before the writers go.
         tokio::time::sleep(Duration::from_millis(200)).await;
         println!(
-            "played {sent} samples and {} /clock messages in {:.1} s; undecodable: {undecodable}",
+            "played {sent} samples and {} /clock messages in {wall:.3} s; undecodable: {undecodable}",
             clocks + 1,
-            started.elapsed().as_secs_f64()
         );
         Ok(())
     })

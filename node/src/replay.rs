@@ -12,6 +12,7 @@ use crate::cli::ReplayArgs;
 use crate::inputs::{self, InputGate, Readings};
 use crate::observed::{bed_profile, comparison, eroded_mass};
 use crate::ros_args::RosArgs;
+use crate::run::{MOUNT_HEIGHT, PARAMETERS};
 use crate::samples::{Admitted, Input, decode, role};
 use crate::solver_thread::{self, Command};
 use crate::topics;
@@ -110,25 +111,20 @@ impl Outputs {
 }
 
 /// The height of each gauge's range sensor above the floor: the live twin's parameters
-/// `gauge_mount_height_m.<gauge>` from `--ros-args -p` or `--params-file`, else the flume's
-/// top. The node's other parameters mean nothing to an in-process replay and are ignored.
+/// `gauge_mount_height_m.<gauge>` (the gauge's name in lower case) from `--ros-args -p` or
+/// `--params-file`, else the flume's top. The node's other parameters mean nothing to an
+/// in-process replay and are ignored; a name that is none of the node's is said.
 fn mount_heights(ros: &RosArgs, gauges: &[String], flume_top_m: f64) -> Result<Vec<f64>> {
-    let node = format!(
-        "{}/{}",
-        ros.namespace
-            .as_deref()
-            .unwrap_or("/")
-            .trim_end_matches('/'),
-        ros.node_name.as_deref().unwrap_or("flume_twin")
-    );
     let mut heights = vec![flume_top_m; gauges.len()];
-    for (name, value) in ros.parameters(&node)? {
-        let Some(gauge) = name.strip_prefix("gauge_mount_height_m.") else {
-            log::info!("parameter {name} does not apply to a replay: ignored");
+    for (name, value) in ros.parameters(&ros.node_fqn("flume_twin"))? {
+        let Some(gauge) = name.strip_prefix(MOUNT_HEIGHT) else {
+            if !PARAMETERS.contains(&name.as_str()) {
+                log::warn!("{name} is not a parameter of flume_twin: ignored");
+            }
             continue;
         };
         // A parameter file may serve cases with more gauges than this one.
-        let Some(k) = gauges.iter().position(|g| g.eq_ignore_ascii_case(gauge)) else {
+        let Some(k) = gauges.iter().position(|g| g.to_lowercase() == gauge) else {
             log::warn!("{name}: this case has no gauge {gauge}: ignored");
             continue;
         };
@@ -146,6 +142,11 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         return crate::play::run(args, ros_args);
     }
     let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
+    if !ros.remaps.is_empty() {
+        log::warn!(
+            "an in-process replay matches topics by their last segments: remaps are ignored"
+        );
+    }
     let Some(config) = &args.config else {
         bail!("--config CASE is needed to replay through the twin");
     };

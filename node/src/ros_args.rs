@@ -113,6 +113,18 @@ impl RosArgs {
     }
 
     /// The topic name after the remaps: the first rule whose source is the name wins.
+    /// The node's full name (`/ns/name`), `default_name` unless `-r __node:=` renames it.
+    pub fn node_fqn(&self, default_name: &str) -> String {
+        format!(
+            "{}/{}",
+            self.namespace
+                .as_deref()
+                .unwrap_or("/")
+                .trim_end_matches('/'),
+            self.node_name.as_deref().unwrap_or(default_name)
+        )
+    }
+
     pub fn remap(&self, topic: &str) -> String {
         self.remaps
             .iter()

@@ -235,10 +235,10 @@ impl Settings {
 }
 
 /// The prefix of the range sensors' mount heights: `gauge_mount_height_m.p1`, m.
-const MOUNT_HEIGHT: &str = "gauge_mount_height_m.";
+pub const MOUNT_HEIGHT: &str = "gauge_mount_height_m.";
 
 /// The node's parameters besides the mount heights (use_sim_time is ROS's own).
-const PARAMETERS: [&str; 5] = [
+pub const PARAMETERS: [&str; 5] = [
     "target_real_time_factor",
     "publish_rate_hz",
     "stale_after_s",
@@ -300,7 +300,7 @@ pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
     let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
     let namespace = ros.namespace.clone().unwrap_or_else(|| "/".into());
     let node_name = ros.node_name.clone().unwrap_or_else(|| "flume_twin".into());
-    let fqn = format!("{}/{node_name}", namespace.trim_end_matches('/'));
+    let fqn = ros.node_fqn("flume_twin");
     let vertical = case.dim() - 1;
     let gauges: Vec<String> = case
         .observations
@@ -544,16 +544,15 @@ async fn serve(
     // With no sensor on the network, a recorded session plays the sensors' part.
     let heard_sensor = Arc::new(AtomicBool::new(false));
     let (fallback_tx, mut fallback_rx) = tokio::sync::mpsc::channel::<Sample>(64);
+    // On simulated time the recorded session is the player's to play, on the wire.
+    let on_sim_time = settings.use_sim_time;
+    if on_sim_time && !args.no_replay {
+        println!("use_sim_time: no recorded session plays the sensors here");
+    }
     let fallback = args
         .replay_when_silent
         .clone()
-        .filter(|_| !args.no_replay)
-        .filter(|_| {
-            if settings.use_sim_time {
-                println!("use_sim_time: the twin waits for /clock and its sensors");
-            }
-            !settings.use_sim_time
-        })
+        .filter(|_| !args.no_replay && !on_sim_time)
         .filter(|path| {
             let exists = path.exists();
             if !exists {
@@ -564,7 +563,8 @@ async fn serve(
             }
             exists
         });
-    let wait_for_sensors = args.wait_for_sensors || fallback.is_some();
+    // A player's clock may start before its first sample: t = 0 is the first sample.
+    let wait_for_sensors = args.wait_for_sensors || fallback.is_some() || on_sim_time;
     if let Some(path) = fallback {
         tokio::spawn(play_when_silent(
             path,
@@ -574,7 +574,9 @@ async fn serve(
             fallback_tx,
         ));
     }
-    let mut gate = InputGate::new(limits);
+    let mut gate = InputGate::new(limits.clone());
+    // A reset the node asked for itself (the clock went back) has already renewed the pacer.
+    let mut reset_by_clock = false;
     let mut pacer = Pacer::new(
         settings.target_rtf,
         settings.stale_after_s,
@@ -600,8 +602,17 @@ async fn serve(
     let mut shutdown = Box::pin(tokio::signal::ctrl_c());
     let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
         .context("cannot watch for SIGTERM")?;
+    println!(
+        "listening: {} and {} gauge topics",
+        full(topics::INFLOW),
+        gauge_names.len()
+    );
     loop {
         tokio::select! {
+            // In order: a player sends /clock just before a sample, on another writer, and
+            // the sample is judged on that clock. Nothing here comes fast enough to starve
+            // the branches after it.
+            biased;
             _ = &mut shutdown => {
                 println!("interrupted at t = {sim_t:.3} s");
                 break;
@@ -610,6 +621,24 @@ async fn serve(
                 println!("terminated at t = {sim_t:.3} s");
                 break;
             }
+            Some(r) = clock_stream.next() => match r {
+                Ok((c, _)) => {
+                    if clock.set(c.clock.as_secs_f64()) {
+                        // A player restarted or looped: a new session, as ROS nodes clear
+                        // their buffers on a jump back; the old stamps would refuse the new.
+                        println!("/clock went back: the twin resets for a new session");
+                        commands
+                            .send(Command::Reset)
+                            .map_err(|_| anyhow!("the solver thread has stopped"))?;
+                        outstanding += 1;
+                        reset_by_clock = true;
+                        gate = InputGate::new(limits.clone());
+                        pacer = Pacer::new(pacer.target_rtf, pacer.stale_after_s, wait_for_sensors);
+                        measured = vec![Readings::default(); gauge_names.len()];
+                    }
+                }
+                Err(e) => log::warn!("/clock: a message could not be read: {e:?}"),
+            },
             Some((topic, r)) = sensor_stream.next() => match r {
                 Ok(sample) => {
                     if !heard_sensor.swap(true, Ordering::Relaxed) {
@@ -628,28 +657,28 @@ async fn serve(
             },
             Some(sample) = fallback_rx.recv() => {
                 recorder.input(&sample);
-                if let Some(now) = clock.now() {
-                    take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, now);
-                }
+                take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, crate::clock::system_s());
             }
-            Some(r) = clock_stream.next() => match r {
-                Ok((c, _)) => clock.set(c.clock.as_secs_f64()),
-                Err(e) => log::warn!("/clock: a message could not be read: {e:?}"),
-            },
             Some(report) = reports.recv() => {
                 outstanding = outstanding.saturating_sub(1);
                 let report: Report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
                 sim_t = report.obs.time_s;
                 if report.reset {
                     // A new start: t = 0 is the next event; queued inputs belonged to the old run.
-                    pacer = Pacer::new(pacer.target_rtf, pacer.stale_after_s, wait_for_sensors);
-                    measured = vec![Readings::default(); gauge_names.len()];
+                    if !std::mem::take(&mut reset_by_clock) {
+                        pacer = Pacer::new(pacer.target_rtf, pacer.stale_after_s, wait_for_sensors);
+                        measured = vec![Readings::default(); gauge_names.len()];
+                    }
                     println!("reset to the case's initial state");
                 }
                 solver_refused += report.refused_inflows;
                 (frames_sent, frames_skipped) = (report.frames_sent, report.frames_skipped);
                 period.add(&report);
-                let origin = pacer.origin().or(clock.now()).unwrap_or(0.0);
+                let Some(origin) = pacer.origin().or(clock.now()) else {
+                    // Simulated time has not started: there is no time to stamp outputs with.
+                    last_obs = report.obs;
+                    continue;
+                };
                 let stamp = Time::from_secs_f64(origin + sim_t).unwrap_or_default();
                 let header = Header { stamp, frame_id: settings.frame_id.clone() };
                 if let Some(out) = &clock_out {
@@ -740,6 +769,9 @@ async fn serve(
                         (true, format!("resumed at t = {sim_t:.3} s"))
                     }
                     Service::Step if !paused => (false, "pause the twin first".to_string()),
+                    Service::Step if clock.now().is_none() => {
+                        (false, "simulated time has not started: no /clock yet".to_string())
+                    }
                     Service::Step => {
                         let chunk = pacer.step(sim_t, args.max_chunk_s);
                         let to = chunk.to_s;

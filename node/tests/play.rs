@@ -5,11 +5,10 @@
 
 mod common;
 
-use common::{ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
+use common::{Proc, ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
 use serde_json::Value;
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 /// The player's and the twin's DDS domain, away from the other tests' traffic.
 const DOMAIN: &str = "7";
@@ -19,21 +18,6 @@ const RATE: f64 = 2.0;
 
 fn stamp(v: &Value) -> f64 {
     v["sec"].as_f64().expect("sec") + v["nanosec"].as_f64().expect("nanosec") * 1e-9
-}
-
-/// Waits for `child` at most `limit`; kills it past that (a hung twin fails the test rather
-/// than CI).
-fn finish(mut child: Child, limit: Duration, what: &str) -> Output {
-    let start = Instant::now();
-    while child.try_wait().expect("wait").is_none() {
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("output");
-            panic!("{what} ran past {limit:?}:\n{}", printed(&out));
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    child.wait_with_output().expect("output")
 }
 
 #[test]
@@ -72,74 +56,52 @@ fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
             .collect()
     };
 
-    // The twin first, in the root namespace where the recording's topics are.
+    // The twin first, in the root namespace where the recording's topics are, then the
+    // listener; the player once both have subscribed, and /clock holds for --delay-s before
+    // the first sample while DDS matches them.
     let twin_rec = dir.join("twin.mcap");
-    let mut twin = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-        .arg("run")
-        .arg(repo_file("launch_configs/ulbra_flume.yaml"))
-        .args(ULBRA_CI)
-        .args(["--loopback", "--domain-id", DOMAIN, "--no-frames"])
-        .args(["--until", "0.3", "--record"])
-        .arg(&twin_rec)
-        .args(["--ros-args", "-p", "use_sim_time:=true"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the twin starts");
-    let mut twin_lines = BufReader::new(twin.stdout.take().expect("stdout")).lines();
-    let mut twin_said = Vec::new();
-    for line in twin_lines.by_ref() {
-        let line = line.expect("the twin's output");
-        let started = line.starts_with("node:");
-        twin_said.push(line);
-        if started {
-            break;
-        }
-    }
-    let twin_out = std::thread::spawn(move || {
-        twin_said.extend(twin_lines.map_while(Result::ok));
-        twin_said.join("\n")
-    });
-    let listener = Command::new("python3")
-        .arg(repo_file("tests/interop/dds_listen.py"))
-        .args([DOMAIN, "/", "120", "5"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the listener starts");
-    // Both have joined the domain before the player's first sample: /clock holds for
-    // --delay-s first.
-    std::thread::sleep(Duration::from_secs(3));
-    let player = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-        .arg("replay")
-        .arg(&session)
-        .args(["--publish", "--loopback", "--domain-id", DOMAIN])
-        .args([
-            "--until",
-            &PLAYED_S.to_string(),
-            "--rate",
-            &RATE.to_string(),
-        ])
-        .args(["--delay-s", "2"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the player starts");
-    let player = finish(player, Duration::from_secs(60), "the player");
-    let player_log = printed(&player);
-    assert!(player.status.success(), "the player failed:\n{player_log}");
-    let twin = finish(twin, Duration::from_secs(600), "the twin");
-    let twin_log = twin_out.join().expect("the twin's output") + &printed(&twin);
-    assert!(twin.status.success(), "the twin failed:\n{twin_log}");
-    let listener = finish(listener, Duration::from_secs(150), "the listener");
-    let heard = printed(&listener);
+    let mut twin = Proc::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .arg("run")
+            .arg(repo_file("launch_configs/ulbra_flume.yaml"))
+            .args(ULBRA_CI)
+            .args(["--loopback", "--domain-id", DOMAIN, "--no-frames"])
+            .args(["--until", "0.3", "--record"])
+            .arg(&twin_rec)
+            .args(["--ros-args", "-p", "use_sim_time:=true"]),
+    );
+    twin.wait_for("listening:", Duration::from_secs(120));
+    let mut listener = Proc::spawn(
+        Command::new("python3")
+            .arg(repo_file("tests/interop/dds_listen.py"))
+            .args([DOMAIN, "/", "180", "5"]),
+    );
+    listener.wait_for("{\"listening\"", Duration::from_secs(60));
+    let mut player = Proc::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .arg("replay")
+            .arg(&session)
+            .args(["--publish", "--loopback", "--domain-id", DOMAIN])
+            .args([
+                "--until",
+                &PLAYED_S.to_string(),
+                "--rate",
+                &RATE.to_string(),
+            ])
+            .args(["--delay-s", "3"]),
+    );
+    let (ok, player_log) = player.finish(Duration::from_secs(60));
+    assert!(ok, "the player failed:\n{player_log}");
+    let (ok, twin_log) = twin.finish(Duration::from_secs(600));
+    assert!(ok, "the twin failed:\n{twin_log}");
+    let (_, heard) = listener.finish(Duration::from_secs(200));
     assert!(
         !heard.contains("Traceback"),
         "the listener failed:\n{heard}"
     );
 
-    // The player: every sample of the window, paced: PLAYED_S recorded seconds at RATE take
-    // at least PLAYED_S / RATE wall seconds (a lower bound, which no slow machine breaks).
+    // The player: every sample of the window, paced: the last goes out no sooner than its
+    // log time, from the first, over RATE (a lower bound, which no slow machine breaks).
     let line = player_log
         .lines()
         .find(|l| l.starts_with("played "))
@@ -149,7 +111,14 @@ fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
     let wall: f64 = words[words.iter().position(|w| *w == "in").expect("in") + 1]
         .parse()
         .expect("seconds");
-    assert!(wall >= PLAYED_S / RATE, "{line}");
+    let last_s = played
+        .iter()
+        .map(|m| m["log_time"].as_f64().expect("log time") * 1e-9 - t0)
+        .fold(0.0, f64::max);
+    assert!(
+        wall >= last_s / RATE,
+        "{line}: the last sample is {last_s:.3} s in"
+    );
 
     // The wire, as Cyclone DDS read it: /clock on the recording's time, only the player's
     // (a twin on simulated time publishes none), from the start to the end of the window;
@@ -233,9 +202,8 @@ fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
     assert!(!predicted.is_empty());
     for p in &predicted {
         let s = stamp(&p["header"]["stamp"]);
-        // The outputs' stamps are the first sample heard plus simulated time (to 0.3 s); the
-        // first heard may be a gauge's, a few ms after the inflow's (50 ms: half a gauge's
-        // period).
+        // The outputs' stamps are the first sample heard (t = 0) plus simulated time (to
+        // 0.3 s); 50 ms, half a gauge's period, covers which sample came first.
         assert!(
             s >= t0 - 1e-3 && s <= t0 + 0.3 + 0.05,
             "an output stamped {:.4} s from the recording's start",
@@ -249,6 +217,84 @@ fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
         assert!(g["measured_m"].as_f64().is_some(), "{g}");
         assert_eq!(g["stale"], false, "{g}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_clock_that_goes_back_resets_the_twin_for_a_new_session() {
+    let Some(_gpu) = gpu() else { return };
+    if !python_has("mcap, mcap_ros2", "mcap mcap-ros2-support") {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("flume-play-back-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let domain = "8";
+    let twin_rec = dir.join("twin.mcap");
+    let mut twin = Proc::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .arg("run")
+            .arg(repo_file("launch_configs/ulbra_flume.yaml"))
+            .args(ULBRA_CI)
+            .args([
+                "--loopback",
+                "--domain-id",
+                domain,
+                "--no-frames",
+                "--record",
+            ])
+            .arg(&twin_rec)
+            .args(["--ros-args", "-p", "use_sim_time:=true"]),
+    );
+    twin.wait_for("listening:", Duration::from_secs(120));
+    // The same 2 s twice: the second time /clock jumps back 2 s, as a restarted player's does.
+    for _ in 0..2 {
+        let (ok, log) = Proc::spawn(
+            Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+                .arg("replay")
+                .arg(repo_file("tests/data/ulbra_session.mcap"))
+                .args(["--publish", "--loopback", "--domain-id", domain])
+                .args(["--until", "2", "--rate", "2", "--delay-s", "2"]),
+        )
+        .finish(Duration::from_secs(60));
+        assert!(ok, "the player failed:\n{log}");
+    }
+    twin.wait_for(
+        "reset to the case's initial state",
+        Duration::from_secs(300),
+    );
+    // A few outputs of the new session, then SIGTERM finishes the recording.
+    std::thread::sleep(Duration::from_secs(5));
+    let status = Command::new("kill")
+        .args(["-TERM", &twin.pid().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let (ok, log) = twin.finish(Duration::from_secs(60));
+    assert!(ok, "the twin failed:\n{log}");
+    assert!(log.contains("/clock went back: the twin resets"), "{log}");
+    // On the new session's clock, nothing the second player sent was refused (the old run's
+    // stamps would have made every one out of order) and no gauge is stale.
+    let out = read_mcap(&twin_rec, &["/diagnostics"]);
+    let last = out["messages"]
+        .as_array()
+        .expect("messages")
+        .last()
+        .expect("diagnostics")["msg"]["status"][0]["values"]
+        .as_array()
+        .expect("values")
+        .iter()
+        .map(|kv| {
+            (
+                kv["key"].as_str().unwrap_or(""),
+                kv["value"].as_str().unwrap_or(""),
+            )
+        })
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect::<std::collections::BTreeMap<String, String>>();
+    assert_eq!(last["rejected_inputs"], "0", "{last:?}");
+    assert_eq!(last["stale_sensors"], "", "{last:?}");
+    assert_eq!(last["sensor_driven"], "true", "{last:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

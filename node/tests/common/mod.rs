@@ -105,3 +105,98 @@ pub fn read_mcap<S: AsRef<std::ffi::OsStr>>(path: &Path, topics: &[S]) -> serde_
     );
     serde_json::from_slice(&out.stdout).expect("JSON")
 }
+
+/// A child process whose output (stdout and stderr, a line at a time) is read as it comes, so
+/// that a full pipe never blocks it, and which is killed when the test ends before it does.
+pub struct Proc {
+    child: std::process::Child,
+    lines: std::sync::mpsc::Receiver<String>,
+    said: std::sync::Arc<Mutex<Vec<String>>>,
+}
+
+impl Proc {
+    pub fn spawn(what: &mut std::process::Command) -> Proc {
+        use std::io::{BufRead, BufReader, Read};
+        let mut child = what
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("{what:?} does not start: {e}"));
+        let (tx, lines) = std::sync::mpsc::channel();
+        let said = std::sync::Arc::new(Mutex::new(Vec::new()));
+        let streams: [Box<dyn Read + Send>; 2] = [
+            Box::new(child.stdout.take().expect("stdout")),
+            Box::new(child.stderr.take().expect("stderr")),
+        ];
+        for stream in streams {
+            let (tx, said) = (tx.clone(), std::sync::Arc::clone(&said));
+            std::thread::spawn(move || {
+                for line in BufReader::new(stream).lines().map_while(Result::ok) {
+                    said.lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .push(line.clone());
+                    let _ = tx.send(line);
+                }
+            });
+        }
+        Proc { child, lines, said }
+    }
+
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Everything it has printed so far.
+    pub fn said(&self) -> String {
+        self.said
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .join("\n")
+    }
+
+    /// Waits at most `limit` for a line that starts with `prefix`.
+    pub fn wait_for(&self, prefix: &str, limit: std::time::Duration) {
+        let deadline = std::time::Instant::now() + limit;
+        loop {
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if line.starts_with(prefix) => return,
+                Ok(_) => continue,
+                Err(_) => panic!(
+                    "no line starting {prefix:?} within {limit:?}:\n{}",
+                    self.said()
+                ),
+            }
+        }
+    }
+
+    /// Waits at most `limit` for it to end (killing it past that, and failing); whether it
+    /// succeeded, and everything it printed.
+    pub fn finish(&mut self, limit: std::time::Duration) -> (bool, String) {
+        let deadline = std::time::Instant::now() + limit;
+        let status = loop {
+            if let Some(status) = self.child.try_wait().expect("wait") {
+                break status;
+            }
+            if std::time::Instant::now() > deadline {
+                let _ = self.child.kill();
+                panic!("still running after {limit:?}:\n{}", self.said());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        };
+        // The readers end at the pipes' end.
+        while self
+            .lines
+            .recv_timeout(std::time::Duration::from_secs(5))
+            .is_ok()
+        {}
+        (status.success(), self.said())
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
