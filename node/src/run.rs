@@ -598,6 +598,9 @@ async fn serve(
     let mut tick = tokio::time::interval(Duration::from_millis(20));
     let mut diag_tick = tokio::time::interval(Duration::from_secs(1));
     let mut diag_count = 0u64;
+    // The terminal's line gives the factor over its own ten seconds: over one, a twin that
+    // advances in 0.1 s chunks reads 0 or 0.1.
+    let mut status_period = Period::new(sim_t);
     let until = args.until;
     let mut shutdown = Box::pin(tokio::signal::ctrl_c());
     let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
@@ -819,6 +822,7 @@ async fn serve(
                 diag_count += 1;
                 // A line on the terminal every ten seconds, for whoever started the twin by hand.
                 if diag_count.is_multiple_of(10) {
+                    let (rtf, _, _) = status_period.take(sim_t);
                     let levels: Vec<String> = gauge_names
                         .iter()
                         .zip(&last_obs.gauges)
