@@ -7,6 +7,7 @@ mod common;
 
 use common::{Proc, ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
 use serde_json::Value;
+use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
@@ -18,6 +19,37 @@ const RATE: f64 = 2.0;
 
 fn stamp(v: &Value) -> f64 {
     v["sec"].as_f64().expect("sec") + v["nanosec"].as_f64().expect("nanosec") * 1e-9
+}
+
+/// The CI-size ULBRA twin on simulated time on DDS domain `domain`, recording to `record`,
+/// with `extra` options; once it has subscribed.
+fn twin_on_sim_time(domain: &str, record: &Path, extra: &[&str]) -> Proc {
+    let twin = Proc::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .arg("run")
+            .arg(repo_file("launch_configs/ulbra_flume.yaml"))
+            .args(ULBRA_CI)
+            .args(["--loopback", "--domain-id", domain, "--no-frames"])
+            .args(extra)
+            .arg("--record")
+            .arg(record)
+            .args(["--ros-args", "-p", "use_sim_time:=true"]),
+    );
+    twin.wait_for("listening:", Duration::from_secs(120));
+    twin
+}
+
+/// The bundled session played on DDS domain `domain` with `extra` options: whether the
+/// player succeeded, and what it printed.
+fn play(domain: &str, extra: &[&str]) -> (bool, String) {
+    Proc::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+            .arg("replay")
+            .arg(repo_file("tests/data/ulbra_session.mcap"))
+            .args(["--publish", "--loopback", "--domain-id", domain])
+            .args(extra),
+    )
+    .finish(Duration::from_secs(60))
 }
 
 #[test]
@@ -60,37 +92,24 @@ fn a_session_played_on_the_wire_drives_a_twin_on_simulated_time() {
     // listener; the player once both have subscribed, and /clock holds for --delay-s before
     // the first sample while DDS matches them.
     let twin_rec = dir.join("twin.mcap");
-    let mut twin = Proc::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-            .arg("run")
-            .arg(repo_file("launch_configs/ulbra_flume.yaml"))
-            .args(ULBRA_CI)
-            .args(["--loopback", "--domain-id", DOMAIN, "--no-frames"])
-            .args(["--until", "0.3", "--record"])
-            .arg(&twin_rec)
-            .args(["--ros-args", "-p", "use_sim_time:=true"]),
-    );
-    twin.wait_for("listening:", Duration::from_secs(120));
+    let mut twin = twin_on_sim_time(DOMAIN, &twin_rec, &["--until", "0.3"]);
     let mut listener = Proc::spawn(
         Command::new("python3")
             .arg(repo_file("tests/interop/dds_listen.py"))
             .args([DOMAIN, "/", "180", "5"]),
     );
     listener.wait_for("{\"listening\"", Duration::from_secs(60));
-    let mut player = Proc::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-            .arg("replay")
-            .arg(&session)
-            .args(["--publish", "--loopback", "--domain-id", DOMAIN])
-            .args([
-                "--until",
-                &PLAYED_S.to_string(),
-                "--rate",
-                &RATE.to_string(),
-            ])
-            .args(["--delay-s", "3"]),
+    let (ok, player_log) = play(
+        DOMAIN,
+        &[
+            "--until",
+            &PLAYED_S.to_string(),
+            "--rate",
+            &RATE.to_string(),
+            "--delay-s",
+            "3",
+        ],
     );
-    let (ok, player_log) = player.finish(Duration::from_secs(60));
     assert!(ok, "the player failed:\n{player_log}");
     let (ok, twin_log) = twin.finish(Duration::from_secs(600));
     assert!(ok, "the twin failed:\n{twin_log}");
@@ -231,32 +250,10 @@ fn a_clock_that_goes_back_resets_the_twin_for_a_new_session() {
     std::fs::create_dir_all(&dir).expect("temp dir");
     let domain = "8";
     let twin_rec = dir.join("twin.mcap");
-    let mut twin = Proc::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-            .arg("run")
-            .arg(repo_file("launch_configs/ulbra_flume.yaml"))
-            .args(ULBRA_CI)
-            .args([
-                "--loopback",
-                "--domain-id",
-                domain,
-                "--no-frames",
-                "--record",
-            ])
-            .arg(&twin_rec)
-            .args(["--ros-args", "-p", "use_sim_time:=true"]),
-    );
-    twin.wait_for("listening:", Duration::from_secs(120));
+    let mut twin = twin_on_sim_time(domain, &twin_rec, &[]);
     // The same 2 s twice: the second time /clock jumps back 2 s, as a restarted player's does.
     for _ in 0..2 {
-        let (ok, log) = Proc::spawn(
-            Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-                .arg("replay")
-                .arg(repo_file("tests/data/ulbra_session.mcap"))
-                .args(["--publish", "--loopback", "--domain-id", domain])
-                .args(["--until", "2", "--rate", "2", "--delay-s", "2"]),
-        )
-        .finish(Duration::from_secs(60));
+        let (ok, log) = play(domain, &["--until", "2", "--rate", "2", "--delay-s", "2"]);
         assert!(ok, "the player failed:\n{log}");
     }
     twin.wait_for(
