@@ -11,6 +11,7 @@
 
 use anyhow::{Context, Result, anyhow};
 use flume_solver::Simulation;
+use flume_solver::case::Particles;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::prelude::*;
@@ -60,6 +61,11 @@ pub struct FrameHeader {
     /// When the frame was sent, ns since the epoch (a reader's latency is its clock minus this).
     pub sent_unix_ns: u64,
     pub units: [u8; 32],
+}
+
+/// A vector in the flume frame (z up): a 2-D case's (x, vertical) becomes (x, 0, z).
+pub fn in_flume_frame(two_d: bool, [a, b, c]: [f32; 3]) -> [f32; 3] {
+    if two_d { [a, 0.0, b] } else { [a, b, c] }
 }
 
 /// The twin's end: the publisher, its notifier, and the pacing.
@@ -150,43 +156,42 @@ impl Frames {
         })
     }
 
-    /// Publishes `sim`'s particles if a frame is due. A frame that cannot go out is skipped
-    /// with a log line; the solver never waits for a reader.
-    pub fn offer(&mut self, sim: &Simulation) {
-        if self.last.is_some_and(|t| t.elapsed() < self.every) {
-            return;
-        }
+    /// Whether a frame is due: at most `rate_hz` a wall second.
+    pub fn due(&self) -> bool {
+        self.last.is_none_or(|t| t.elapsed() >= self.every)
+    }
+
+    /// Publishes `p`, `sim`'s particles as read back for this chunk, as the next frame. A
+    /// frame that cannot go out is skipped with a log line; the solver never waits for a
+    /// reader.
+    pub fn offer(&mut self, sim: &Simulation, p: &Particles) {
         self.last = Some(Instant::now());
-        if let Err(e) = self.send(sim) {
-            self.skipped += 1;
-            log::warn!("particle frame skipped: {e:#}");
+        let sent = self
+            .fill(sim, p)
+            .and_then(|()| self.publish(sim.steps(), sim.time_s()));
+        if let Err(e) = sent {
+            self.skip(&format!("{e:#}"));
         }
     }
 
-    fn send(&mut self, sim: &Simulation) -> Result<()> {
-        self.fill(sim)?;
-        self.publish(sim.steps(), sim.time_s())
+    /// Counts a frame that did not go out, and says why.
+    pub fn skip(&mut self, why: &str) {
+        self.last = Some(Instant::now());
+        self.skipped += 1;
+        log::warn!("particle frame skipped: {why}");
     }
 
-    /// Takes `sim`'s particles into the frame buffer.
-    pub fn fill(&mut self, sim: &Simulation) -> Result<()> {
-        let p = sim
-            .read_particles()
-            .context("cannot read the particles back")?;
+    /// Takes `p`, `sim`'s particles, into the frame buffer, with their regions.
+    pub fn fill(&mut self, sim: &Simulation, p: &Particles) -> Result<()> {
         let regions = sim.regions().context("cannot read the regions back")?;
         let two_d = sim.case().dim() == 2;
         self.buffer.clear();
         self.buffer.extend((0..p.len()).map(|i| {
             let [x, y, z, _] = p.positions[i];
             let [u, v, w, rho] = p.vel_rho[i];
-            let (position, velocity) = if two_d {
-                ([x, 0.0, y], [u, 0.0, v])
-            } else {
-                ([x, y, z], [u, v, w])
-            };
             Particle {
-                position,
-                velocity,
+                position: in_flume_frame(two_d, [x, y, z]),
+                velocity: in_flume_frame(two_d, [u, v, w]),
                 density: rho,
                 phase: u8::try_from(p.phase(i)).unwrap_or(u8::MAX),
                 // The solver's region word: the region in the low byte, 256 when held.

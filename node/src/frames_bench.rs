@@ -105,7 +105,10 @@ pub fn run(case_path: &std::path::Path, seconds: f64) -> Result<()> {
         .as_ref()
         .map_or(0, |_| flume_solver::case::parked_phase(&case));
     let mut frames = Frames::open(&service, count, parked, f64::INFINITY)?;
-    frames.fill(&sim)?;
+    let particles = sim
+        .read_particles()
+        .context("cannot read the particles back")?;
+    frames.fill(&sim, &particles)?;
     let bytes = count * std::mem::size_of::<Particle>();
     println!(
         "particle frames over iceoryx2: case {} ({}), {count} particles, {} bytes a frame; \

@@ -1,10 +1,11 @@
 //! The solver on a thread of its own: GPU work never blocks the async runtime. The node sends
 //! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
 
-use crate::frames::Frames;
+use crate::frames::{Frames, in_flume_frame};
 use crate::output::recorder::Recorder;
 use crate::visual::CloudPoint;
 use anyhow::{Context, Result};
+use flume_solver::case::Particles;
 use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -135,14 +136,11 @@ pub fn spawn(
                         inflow,
                         cloud,
                     } => run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
-                        if let Some(f) = frames.as_mut() {
-                            f.offer(&sim);
-                        }
-                        let cloud = if cloud {
-                            Some(cloud_points(&sim, parked)?)
-                        } else {
-                            None
-                        };
+                        let particles = read_back(&sim, cloud, frames.as_mut())?;
+                        let cloud = particles
+                            .as_ref()
+                            .filter(|_| cloud)
+                            .map(|p| cloud_points(&sim, p, parked));
                         observe(&sim, recorder.as_mut(), k).map(|obs| Report {
                             obs,
                             wall_s,
@@ -241,21 +239,46 @@ fn run_chunk(
 }
 
 /// The particles in the flume frame (z up), without the parked ones.
-fn cloud_points(sim: &Simulation, parked: Option<u32>) -> Result<Vec<CloudPoint>, String> {
-    let p = sim
-        .read_particles()
-        .map_err(|e| format!("cannot read the particles back from the GPU: {e}"))?;
+/// After a chunk, the particles read back once for the cloud and a due frame, which goes out.
+/// A failed readback fails the chunk only when the cloud needed it; a frame is just skipped.
+fn read_back(
+    sim: &Simulation,
+    cloud: bool,
+    frames: Option<&mut Frames>,
+) -> Result<Option<Particles>, String> {
+    let frame = frames.filter(|f| f.due());
+    if !cloud && frame.is_none() {
+        return Ok(None);
+    }
+    match sim.read_particles() {
+        Ok(p) => {
+            if let Some(f) = frame {
+                f.offer(sim, &p);
+            }
+            Ok(Some(p))
+        }
+        Err(e) if cloud => Err(format!("cannot read the particles back from the GPU: {e}")),
+        Err(e) => {
+            if let Some(f) = frame {
+                f.skip(&format!("cannot read the particles back: {e}"));
+            }
+            Ok(None)
+        }
+    }
+}
+
+fn cloud_points(sim: &Simulation, p: &Particles, parked: Option<u32>) -> Vec<CloudPoint> {
     let two_d = sim.case().dim() == 2;
-    Ok((0..p.len())
+    (0..p.len())
         .filter(|&i| Some(p.phase(i)) != parked)
         .map(|i| {
             let [x, y, z, _] = p.positions[i];
             let [u, v, w, _] = p.vel_rho[i];
             CloudPoint {
-                position: if two_d { [x, 0.0, y] } else { [x, y, z] },
+                position: in_flume_frame(two_d, [x, y, z]),
                 speed: (u * u + v * v + w * w).sqrt(),
                 phase: u8::try_from(p.phase(i)).unwrap_or(u8::MAX),
             }
         })
-        .collect())
+        .collect()
 }
