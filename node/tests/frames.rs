@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{ULBRA_CI, gpu, printed, python_has, repo_file};
+use common::{gpu, printed, python_has, repo_file, ulbra_twin};
 use serde_json::Value;
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -17,12 +17,8 @@ use std::process::{Child, Command, Stdio};
 const PARTICLES: u64 = 4570;
 
 fn twin(service: &str, until: &str) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-        .current_dir(repo_file(""))
-        .args(["run", "launch_configs/ulbra_flume.yaml"])
-        .args(ULBRA_CI)
+    ulbra_twin()
         .args([
-            "--loopback",
             "--no-replay",
             "--until",
             until,
@@ -175,4 +171,34 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
         log.contains("dead iceoryx2 node(s) left in shared memory"),
         "{log}"
     );
+}
+
+/// `bench --frames` at the paper's count: a figure, not a timed test. What is checked is that
+/// the reader took whole frames of every particle: their mean density is a flume's (water
+/// 1000, sand 2650 kg/m3, walls between), not the zeros of an unwritten sample.
+#[test]
+fn the_frame_benchmark_reads_whole_frames_at_the_paper_s_count() {
+    let Some(_gpu) = gpu() else { return };
+    let out = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+        .current_dir(repo_file(""))
+        .args(["bench", "--frames", "--steps-seconds", "0.5"])
+        .output()
+        .expect("runs the benchmark");
+    let log = printed(&out);
+    assert!(out.status.success(), "{log}");
+    assert!(
+        log.contains("21894 particles, 700680 bytes a frame"),
+        "{log}"
+    );
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("the reader read every particle of "))
+        .unwrap_or_else(|| panic!("no reader line:\n{log}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let read: u64 = words[6].parse().expect("frames read");
+    assert!(read >= 1, "{line}");
+    let density: f64 = words[words.iter().position(|w| *w == "density").expect("density") + 1]
+        .parse()
+        .expect("a mean density");
+    assert!((1000.0..=2650.0).contains(&density), "{line}");
 }

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{Proc, ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
+use common::{Proc, gpu, printed, python_has, read_mcap, repo_file, ulbra_twin};
 use serde_json::Value;
 use std::path::Path;
 use std::process::Command;
@@ -25,11 +25,8 @@ fn stamp(v: &Value) -> f64 {
 /// with `extra` options; once it has subscribed.
 fn twin_on_sim_time(domain: &str, record: &Path, extra: &[&str]) -> Proc {
     let twin = Proc::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-            .arg("run")
-            .arg(repo_file("launch_configs/ulbra_flume.yaml"))
-            .args(ULBRA_CI)
-            .args(["--loopback", "--domain-id", domain, "--no-frames"])
+        ulbra_twin()
+            .args(["--domain-id", domain, "--no-frames"])
             .args(extra)
             .arg("--record")
             .arg(record)

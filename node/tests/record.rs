@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file};
+use common::{ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file, ulbra_twin};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -15,12 +15,8 @@ use std::time::{Duration, Instant};
 /// Starts the twin at CI size in the repository's root, so the bundled session is found where
 /// the README's command finds it.
 fn start(record: &Path) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-        .current_dir(repo_file(""))
-        .args(["run", "launch_configs/ulbra_flume.yaml"])
-        .args(ULBRA_CI)
+    ulbra_twin()
         .args([
-            "--loopback",
             "--silent-wait-s",
             "0.5",
             "--record",

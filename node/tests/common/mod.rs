@@ -89,6 +89,18 @@ pub const ULBRA_CI: [&str; 4] = [
     "open_flume.reservoir_particles=2500",
 ];
 
+/// `flume-twin run` on the CI-size ULBRA flume from the repository's root (where the bundled
+/// session is, as for the README's command), DDS on loopback only; the test adds its own
+/// options.
+pub fn ulbra_twin() -> std::process::Command {
+    let mut twin = std::process::Command::new(env!("CARGO_BIN_EXE_flume-twin"));
+    twin.current_dir(repo_file(""))
+        .args(["run", "launch_configs/ulbra_flume.yaml"])
+        .args(ULBRA_CI)
+        .arg("--loopback");
+    twin
+}
+
 /// A recording as Python's `mcap` and `mcap-ros2-support` read it
 /// (`tests/interop/read_mcap.py`), with the messages of `topics` decoded.
 pub fn read_mcap<S: AsRef<std::ffi::OsStr>>(path: &Path, topics: &[S]) -> serde_json::Value {
