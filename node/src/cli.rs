@@ -29,6 +29,9 @@ pub enum Command {
     /// Write a synthetic flume session (the inflow and gauge topics) as an MCAP recording:
     /// a simple hydraulic model of the case's flume plus a stated sensor noise model.
     MakeSession(MakeSessionArgs),
+    /// Run a case once per value of one field (a roughness ladder, say) and report the eroded
+    /// sediment mass each run ends with: a table, sweep.csv and a bar chart, sweep.png.
+    Sweep(SweepArgs),
 }
 
 #[derive(Debug, Args)]
@@ -155,6 +158,27 @@ pub struct SimulateArgs {
     /// discharge held until the next row's time.
     #[arg(long, value_name = "FILE")]
     pub inflow: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Case file (YAML) with an open flume, e.g. launch_configs/ulbra_flume.yaml.
+    pub case: PathBuf,
+    /// The field to vary and its values, one run each in this order, e.g.
+    /// `phases.1.sediment.ks_over_d50=1,2,3,5,7,10` (the key as for --set).
+    #[arg(long = "set-values", value_name = "KEY=V1,V2,...")]
+    pub set_values: String,
+    /// Override a field of every run's case, e.g. `--set numerics.dp_m=0.01` (repeatable; a
+    /// number in the key indexes a list).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Simulated time each run stops at, where the eroded mass is read, s [default: the
+    /// case's time.end_s].
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true, value_parser = positive)]
+    pub until: Option<f64>,
+    /// Output directory for sweep.csv and sweep.png [default: out/<case name>_sweep].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -22,6 +22,7 @@ mod samples;
 mod session;
 mod simulate;
 mod solver_thread;
+mod sweep;
 mod table;
 mod tap;
 mod topics;
@@ -49,6 +50,7 @@ fn main() -> ExitCode {
         cli::Command::Run(args) => run::run(&args, &ros_args),
         cli::Command::Replay(args) => replay::run(&args, &ros_args),
         cli::Command::MakeSession(args) => session::run(&args),
+        cli::Command::Sweep(args) => sweep::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

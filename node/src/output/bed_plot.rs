@@ -16,8 +16,8 @@ const FONT_CANDIDATES: [&str; 3] = [
 ];
 
 /// Registers DejaVu Sans as plotters' "sans-serif" once; false when no candidate was found,
-/// and the plot then goes without text.
-fn font_registered() -> bool {
+/// and the plots then go without text.
+pub fn font_registered() -> bool {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     *REGISTERED.get_or_init(|| {
         for path in FONT_CANDIDATES {
@@ -30,7 +30,7 @@ fn font_registered() -> bool {
             }
         }
         log::warn!(
-            "no DejaVu Sans font found (install fonts-dejavu-core): the bed plot has no labels"
+            "no DejaVu Sans font found (install fonts-dejavu-core): the plots have no labels"
         );
         false
     })

@@ -175,8 +175,9 @@ impl<W: Write> ErodedMassCsv<W> {
     }
 }
 
-/// Quotes a header cell when a gauge name would otherwise break the CSV (RFC 4180).
-fn field(s: &str) -> String {
+/// Quotes a cell when a gauge name or an error message would otherwise break the CSV
+/// (RFC 4180).
+pub fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

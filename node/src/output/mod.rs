@@ -1,7 +1,8 @@
-//! Files a run leaves behind: the gauge time series (CSV), particle snapshots (VTK) and the
-//! plot of the final bed (PNG).
+//! Files a run leaves behind: the gauge time series (CSV), particle snapshots (VTK), the
+//! plot of the final bed (PNG) and a sweep's chart of eroded mass (PNG).
 
 pub mod bed_plot;
 pub mod csv;
 pub mod recorder;
+pub mod sweep_plot;
 pub mod vtk;

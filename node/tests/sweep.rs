@@ -1,0 +1,156 @@
+//! `flume-twin sweep` as a user runs it: a two-value roughness ladder on a short open flume,
+//! and malformed ladders refused before anything runs or is written.
+
+mod common;
+
+use common::{csv_rows, gpu, repo_file};
+use flume_solver::Case;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_flume-twin");
+
+/// The short open flume: sand sinks into its collector within a few tenths of a second.
+const CASE: &str = "solver/tests/cases/collector_2d.yaml";
+/// Its sand is phase 1.
+const KEY: &str = "phases.1.sediment.ks_over_d50";
+
+/// A fresh, empty directory for one test's files.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("sweep")
+        .join(name);
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn sweep(case: &str, ladder: &str, out_dir: &Path, more: &[&str]) -> Output {
+    Command::new(BIN)
+        .arg("sweep")
+        .arg(repo_file(case))
+        .args(["--set-values", ladder, "--out", out_dir.to_str().unwrap()])
+        .args(more)
+        .output()
+        .unwrap()
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Two roughnesses, given out of order: a row each in that order, each run to the end, with the
+/// eroded mass of Eq. 34 (particles times dp^2 rho_s, per metre), the chart, and the table.
+#[test]
+fn a_roughness_ladder_gives_a_row_per_value_in_order() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = scratch("ladder");
+    let out_dir = dir.join("out");
+    let out = sweep(CASE, &format!("{KEY}=7,1"), &out_dir, &["--until", "0.3"]);
+    let stdout = text(&out.stdout);
+    assert!(
+        out.status.success(),
+        "sweep failed: {}\n{stdout}",
+        text(&out.stderr)
+    );
+
+    let case = Case::from_path(&repo_file(CASE)).unwrap();
+    let dp = case.numerics.dp_m;
+    let rho_s = case.phases[1].rho0_kg_per_m3;
+    let width = case.open_flume.as_ref().unwrap().width_m;
+    let rows = csv_rows(&out_dir.join("sweep.csv"));
+    let values: Vec<&str> = rows.iter().map(|r| r[KEY].as_str()).collect();
+    assert_eq!(values, ["7", "1"], "{rows:?}");
+    let mut collected = 0;
+    for r in &rows {
+        assert_eq!(r["status"], "ok", "{r:?}");
+        assert_eq!(r["time_s"].parse::<f64>().unwrap(), 0.3, "{r:?}");
+        let kg_per_m: f64 = r["eroded_kg_per_m"].parse().unwrap();
+        let kg: f64 = r["eroded_kg"].parse().unwrap();
+        let particles: u64 = r["eroded_particles"].parse().unwrap();
+        assert!(kg_per_m.is_finite() && kg_per_m >= 0.0, "{r:?}");
+        let eq34 = particles as f64 * dp * dp * rho_s;
+        assert!(
+            (kg_per_m - eq34).abs() <= 1e-9 * eq34.max(1.0),
+            "{kg_per_m} kg/m is not {particles} x dp^2 rho_s = {eq34}"
+        );
+        assert!((kg - kg_per_m * width).abs() <= 1e-9 * kg.max(1.0), "{r:?}");
+        assert!(r["steps"].parse::<u64>().unwrap() > 0, "{r:?}");
+        collected += particles;
+    }
+    // Without collected sand the mass check above would hold for any particle mass.
+    assert!(collected > 0, "no sand reached the collector: {rows:?}");
+
+    let png = fs::read(out_dir.join("sweep.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+
+    // The table: a line per value, first cell the value, ending in its status.
+    for value in ["7", "1"] {
+        assert!(
+            stdout.lines().any(|l| {
+                l.split_whitespace().next() == Some(value) && l.trim_end().ends_with("ok")
+            }),
+            "no table row for {value}:\n{stdout}"
+        );
+    }
+}
+
+/// Each malformed ladder fails with its reason before the GPU is opened or anything is
+/// written. In the non-number case the bad value is the second one: a sweep that ran values
+/// as it read them would open the adapter for the first.
+#[test]
+fn malformed_ladders_are_refused_before_any_run() {
+    let dir = scratch("malformed");
+    let out_dir = dir.join("out");
+    let flag = format!("{KEY}=5");
+    // (case, ladder, further arguments, what the error must say)
+    let refusals: [(&str, String, &[&str], &[&str]); 7] = [
+        (CASE, KEY.to_string(), &[], &["has no '='"]),
+        (CASE, format!("{KEY}="), &[], &["lists no values"]),
+        (
+            CASE,
+            format!("{KEY}=3,rough"),
+            &[],
+            &["phases[1].sediment.ks_over_d50", "rough"],
+        ),
+        (
+            CASE,
+            "phases.1.sediment.bogus_knob=1,2".to_string(),
+            &[],
+            &["phases[1].sediment.bogus_knob"],
+        ),
+        (
+            "launch_configs/dambreak_water.yaml",
+            "numerics.cfl=0.2,0.1".to_string(),
+            &[],
+            &["sweep needs an open flume"],
+        ),
+        (
+            CASE,
+            format!("{KEY}=1,2"),
+            &["--until", "-1"],
+            &["--until", "positive"],
+        ),
+        (CASE, format!("{KEY}=1,2"), &["--set", &flag], &["both set"]),
+    ];
+    for (case, ladder, more, expected) in &refusals {
+        let out = sweep(case, ladder, &out_dir, more);
+        let stderr = text(&out.stderr);
+        assert!(!out.status.success(), "{ladder} {more:?} was accepted");
+        for word in expected.iter() {
+            assert!(
+                stderr.contains(word),
+                "{ladder} {more:?}: no {word:?} in: {stderr}"
+            );
+        }
+        assert!(
+            !text(&out.stdout).contains("adapter:"),
+            "{ladder} {more:?} opened the GPU first"
+        );
+        assert!(
+            !out_dir.exists(),
+            "{ladder} {more:?} created the output directory"
+        );
+    }
+}
