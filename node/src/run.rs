@@ -855,6 +855,10 @@ async fn serve(
                     ("published_outputs", published_outputs.to_string()),
                     ("decimated_outputs", decimated_outputs.to_string()),
                     ("recoveries", last_obs.recoveries.to_string()),
+                    (
+                        "excluded_particles",
+                        last_obs.flume.as_ref().map_or(0, |f| f.excluded_particles).to_string(),
+                    ),
                     ("particle_frames_sent", frames_sent.to_string()),
                     ("particle_frames_skipped", frames_skipped.to_string()),
                 ];

@@ -17,6 +17,7 @@ const TICKS_PER_S: f64 = 1e6;
 pub fn run(args: &SimulateArgs) -> Result<()> {
     // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
     let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
+    flume_solver::flume::check_inflow(&case).context("the case file was refused")?;
     let end_s = match args.until {
         Some(t) if !(t.is_finite() && t > 0.0) => {
             bail!("--until must be a positive time in s, got {t}")
@@ -70,12 +71,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let target_s = (k as f64 * interval_s).min(end_s);
         if let Err(err) = advance(&mut sim, inflow.as_ref(), target_s) {
             progress.abandon();
-            if matches!(
-                err.downcast_ref::<SolverError>(),
-                Some(SolverError::BlowUp { .. })
-            ) {
+            if let Some(SolverError::BlowUp { culprits, .. }) = err.downcast_ref::<SolverError>() {
                 // The broken state shows where it went wrong; losing it would waste the run.
-                if let Err(e) = recorder.snapshot(&sim, "particles_failed.vtk") {
+                // Its `culprit` field marks the particles the error names.
+                let ids: Vec<u32> = culprits.iter().map(|c| c.id).collect();
+                if let Err(e) = recorder.snapshot_marked(&sim, "particles_failed.vtk", &ids) {
                     log::warn!("could not write the failed state: {e:#}");
                 }
             }
@@ -209,6 +209,15 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
         "max density error".to_string(),
         format!("{:.3e}", last.max_density_error),
     ]);
+    if let Some(f) = &last.flume {
+        t.row([
+            "particles excluded".to_string(),
+            format!(
+                "{} ({} sand; density out of range, recycled)",
+                f.excluded_particles, f.excluded_sediment
+            ),
+        ]);
+    }
     t.row([
         "blow-ups recovered".to_string(),
         format!("{} (CFL now {:.3})", last.recoveries, last.cfl),

@@ -242,7 +242,41 @@ fn blow_up_exits_non_zero_and_keeps_outputs() {
         "rows before the failure were lost: {csv}"
     );
     assert!(out_dir.join("particles_0001.vtk").exists());
-    assert!(out_dir.join("particles_failed.vtk").exists());
+    // The error names the particles furthest from health, and the failed state marks them.
+    assert!(stderr.contains("worst particles: id "), "{stderr}");
+    let failed = fs::read(out_dir.join("particles_failed.vtk")).unwrap();
+    assert!(
+        failed.windows(21).any(|w| w == b"SCALARS culprit int 1"),
+        "particles_failed.vtk marks no culprit"
+    );
+}
+
+/// A case whose own inflow the inlet cannot carry (5 m3/s through a 2 cm x 8.6 cm opening,
+/// 2,900 m/s) is refused before it runs, naming the field and the limit, 0.3 c0 through the
+/// opening with c0 = 10 m/s: 5.16e-3 m3/s. It used to blow up at t = 4 us after four retries.
+#[test]
+fn an_inflow_the_inlet_cannot_carry_is_refused_up_front() {
+    let dir = scratch("inflow_too_big");
+    let out_dir = dir.join("out");
+    let out = flume_twin(&[
+        "simulate",
+        repo_file("launch_configs/ulbra_flume.yaml")
+            .to_str()
+            .unwrap(),
+        "--set",
+        "numerics.dp_m=0.01",
+        "--set",
+        "open_flume.inflow_m3_per_s=5",
+        "--until",
+        "0.01",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "it ran: {}", text(&out.stdout));
+    assert!(stderr.contains("open_flume.inflow_m3_per_s"), "{stderr}");
+    assert!(stderr.contains("at most 5.1600e-3 m3/s"), "{stderr}");
+    assert!(!out_dir.exists(), "outputs were started for a refused case");
 }
 
 /// Reads a snapshot with meshio, a VTK reader nobody here wrote (tests/interop/read_vtk.py).

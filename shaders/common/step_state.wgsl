@@ -2,6 +2,21 @@
 // of steps, with time counted from the chunk's start) and reads it back after; no stage waits
 // for the host in between.
 
+// A particle as it was when it was excluded (`exclude` in store_state.wgsl).
+struct ExcludedParticle {
+    id: u32,
+    phase: u32,
+    x: f32,
+    y: f32,
+    u: f32,
+    v: f32,
+    rho: f32,
+    pad: u32,
+}
+
+// Mirrors `EXCLUDED_LOG_LEN` in solver/src/gpu/params.rs.
+const EXCLUDED_LOG_LEN: u32 = 8u;
+
 struct StepState {
     dt: f32,                    // the step being taken, s (0 once the chunk is done)
     t_rel: f32,                 // time since the chunk started, s
@@ -15,6 +30,11 @@ struct StepState {
     dt_taken: f32,              // the last step actually taken, s
     eroded: atomic<u32>,        // sediment particles collected in this chunk (open flume)
     parked: atomic<u32>,        // particles parked in this chunk (open flume)
+    excluded: atomic<u32>,      // particles excluded for a density out of range in this chunk
+    excluded_sediment: atomic<u32>, // of which sediment (they are recycled as water)
+    pad0: u32,
+    pad1: u32,
+    excluded_log: array<ExcludedParticle, EXCLUDED_LOG_LEN>, // the first ones of the chunk
 }
 
 const STATUS_NON_FINITE: u32 = 1u;

@@ -16,7 +16,7 @@ fn check_health(x: vec3<f32>, v: vec3<f32>, rho: f32, rho0: f32) {
     // NaN compares false with everything; infinities exceed the largest finite f32.
     if (!(abs(s) <= 3.0e38)) {
         flags |= STATUS_NON_FINITE;
-    } else if (abs(rho / rho0 - 1.0) > params.rho_ratio_max) {
+    } else if (out_of_range(rho, rho0)) {
         flags |= STATUS_DENSITY_RUNAWAY;
     }
     if (flags != 0u) {
@@ -40,12 +40,33 @@ fn park(i: u32, id: u32, eroded: bool) {
     }
 }
 
+// Excludes free particle i (id `id`, phase `phase`) whose density left the range rho0 (1 +/-
+// rho_ratio_max) (DualSPHysics' RhopOut): it is parked, as water over the weir is, so that the
+// inlet recycles it, and counted, the first few of a chunk logged with their state.
+fn exclude(i: u32, id: u32, phase: u32, x: vec3<f32>, v: vec3<f32>, rho: f32) {
+    let k = atomicAdd(&state.excluded, 1u);
+    if (k < EXCLUDED_LOG_LEN) {
+        state.excluded_log[k] = ExcludedParticle(id, phase, x.x, x.y, v.x, v.y, rho, 0u);
+    }
+    if (params.sediment.phase != 0u && phase == params.sediment.phase) {
+        atomicAdd(&state.excluded_sediment, 1u);
+    }
+    park(i, id, false);
+}
+
+// Whether a finite density is outside rho0 (1 +/- rho_ratio_max); NaN is not (check_health).
+fn out_of_range(rho: f32, rho0: f32) -> bool {
+    return abs(rho / rho0 - 1.0) > params.rho_ratio_max;
+}
+
 // Writes particle i's (id `id`) new position x, velocity v and density rho (p, vr: its old
 // state). Walls (DBC) keep their position and velocity, and their density never drops below
 // rho0 so that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest.
 // In an open flume: parked particles stay parked; fluid past the outlet and sediment in the
 // collector are parked; the inlet buffer moves at the inlet velocity, at its density; water in
-// a bottom outlet's duct moves at the valve's velocity.
+// a bottom outlet's duct moves at the valve's velocity; a free particle whose density leaves
+// the range is excluded (a lone splash meeting a wall compresses by about its Mach number
+// v / c0: that is one particle's fate, not a blow-up of the run).
 fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, ph: Phase) {
     let phase = bitcast<u32>(p.w);
     let f = params.flume;
@@ -87,6 +108,10 @@ fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: ve
         // Without tension (the case's clamp_negative_pressure) the density never falls below
         // rest: a sheet too thin for a full kernel would otherwise thin out without end.
         let r = select(rho, max(rho, ph.rho0), params.clamp_pressure != 0u);
+        if (f.enabled != 0u && out_of_range(r, ph.rho0) && abs(dot(x, x) + dot(v, v)) <= 3.0e38) {
+            exclude(i, id, phase, x, v, r);
+            return;
+        }
         positions_out[i] = vec4<f32>(x, p.w);
         vel_rho_out[i] = vec4<f32>(v, r);
         check_health(x, v, r, ph.rho0);

@@ -9,6 +9,7 @@ pub mod case;
 pub mod config;
 pub mod flume;
 pub mod gpu;
+pub mod health;
 pub mod observe;
 pub mod physics;
 pub mod pipeline;

@@ -66,6 +66,10 @@ pub struct FlumeObservation {
     pub parked_particles: u64,
     /// Inlet particles not placed for want of parked ones, since the start.
     pub starved_particles: u64,
+    /// Particles excluded for a density out of range since the start (recycled through the
+    /// inlet; `crate::health`), and how many of them were sediment.
+    pub excluded_particles: u64,
+    pub excluded_sediment: u64,
 }
 
 /// The top of each fluid phase's layer and the free surface along one vertical line.

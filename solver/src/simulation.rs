@@ -5,10 +5,14 @@
 
 use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
-use crate::flume::{BoundaryConditions, FlumeState, MAX_INLET_MACH, parked_slots};
+use crate::flume::{
+    BoundaryConditions, FlumeState, MAX_INLET_MACH, max_inflow_m3_per_s, parked_slots,
+};
 use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use crate::gpu::params::*;
 use crate::gpu::{GpuContext, GpuError};
+use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
+pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
 use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
 use bytemuck::Zeroable;
@@ -24,11 +28,21 @@ pub enum SolverError {
         "the case's neighbour grid has {0} cells; the solver's cell indices are 32-bit: use a coarser dp or a smaller domain"
     )]
     TooManyCells(u64),
-    #[error("simulation blew up at t = {time_s:.6} s (step {step}): {health}")]
+    #[error(
+        "simulation blew up at t = {time_s:.6} s (step {step}): {health}{}; worst particles: {}",
+        recurring_cfl.map_or(String::new(), |c| format!(
+            "; it recurred at the same simulated time with CFL {}: not a time-step problem", c as f32
+        )),
+        health::list(culprits)
+    )]
     BlowUp {
         time_s: f64,
         step: u64,
         health: Health,
+        /// The particles furthest from health when it failed (excluded ones first), worst first.
+        culprits: Vec<Culprit>,
+        /// The CFL number of a retry that failed at the same simulated time as the try before.
+        recurring_cfl: Option<f64>,
     },
     #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
     TimeGoesBack { target_s: f64, now_s: f64 },
@@ -48,38 +62,6 @@ pub enum SolverError {
     InvalidParameter { name: &'static str, reason: String },
 }
 
-/// Health flags raised on the GPU by the step loop.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Health(pub u32);
-
-impl Health {
-    pub const NON_FINITE: u32 = 1;
-    pub const DENSITY_RUNAWAY: u32 = 2;
-    pub const DT_COLLAPSE: u32 = 4;
-    pub fn is_ok(self) -> bool {
-        self.0 == 0
-    }
-}
-
-impl std::fmt::Display for Health {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mut parts = Vec::new();
-        if self.0 & Self::NON_FINITE != 0 {
-            parts.push("a particle has a NaN or infinite position, velocity or density");
-        }
-        if self.0 & Self::DENSITY_RUNAWAY != 0 {
-            parts.push("a density left the weakly compressible range");
-        }
-        if self.0 & Self::DT_COLLAPSE != 0 {
-            parts.push("the stable time step collapsed");
-        }
-        if parts.is_empty() {
-            parts.push("healthy");
-        }
-        write!(f, "{}", parts.join("; "))
-    }
-}
-
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
 pub const MAX_RECOVERIES_PER_CHUNK: u32 = 4;
@@ -91,22 +73,8 @@ pub const CFL_RESTORE_AFTER_CHUNKS: u32 = 50;
 /// this are accepted so that an operator (or a test) can see the recovery bring it back down.
 pub const MAX_CFL: f64 = 5.0;
 
-/// A blow-up the solver recovered from by rolling back and shrinking the time step.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Recovery {
-    /// When it blew up, s, and what the GPU saw.
-    pub failed_at_s: f64,
-    pub health: Health,
-    /// The time it rolled back to, s, and the CFL number it retried with.
-    pub restored_to_s: f64,
-    pub cfl: f64,
-}
-
 /// Largest number of steps recorded into one submission.
 const MAX_STEPS_PER_SUBMIT: u32 = 400;
-/// |rho / rho0 - 1| above which a density is a runaway: ten times the 1 % that a weakly
-/// compressible flow shows with c0 >= 10 u_max (Eq. 5).
-const RHO_RATIO_MAX: f32 = 0.1;
 
 pub struct Simulation {
     gpu: Arc<GpuContext>,
@@ -131,6 +99,9 @@ pub struct Simulation {
     flume: Option<FlumeState>,
     /// Time and eroded mass (kg/m) at the previous observation, for the erosion rate.
     last_eroded: std::cell::Cell<(f64, f64)>,
+    /// Exclusions in one submission beyond which the run has blown up.
+    max_excluded: u32,
+    exclusion_log: ExclusionLog,
 }
 
 fn divisions_of(case: &Case, h: f64) -> u32 {
@@ -178,6 +149,7 @@ impl Simulation {
             return Err(SolverError::TooManyParticles(count));
         }
         GpuBuffers::check_limits(&gpu, count, n_cells)?;
+        crate::flume::check_inflow(case)?;
         let particles = case::generate(case, &derived);
         // A sound speed too low for the fluid's height starts outside the weakly compressible
         // range: say so now, not as a blow-up at the first step.
@@ -251,6 +223,11 @@ impl Simulation {
             multiphase,
         );
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
+        let max_excluded = health::max_excluded_per_chunk(
+            (0..particles.len())
+                .filter(|&i| particles.phase(i) != WALL_PHASE)
+                .count(),
+        );
         Ok(Simulation {
             gpu,
             case: case.clone(),
@@ -268,8 +245,10 @@ impl Simulation {
             recoveries: Vec::new(),
             cfl_target: params.cfl,
             clean_chunks: 0,
+            max_excluded,
             flume,
             last_eroded: std::cell::Cell::new((0.0, 0.0)),
+            exclusion_log: ExclusionLog::default(),
         })
     }
 
@@ -330,42 +309,60 @@ impl Simulation {
         let saved_flume = self.flume.clone();
         self.copy_state(&self.buffers.a, &self.buffers.snapshot);
         let mut tries = 0;
+        // When and with what step the last try failed: a retry that fails at the same time
+        // with a smaller step shows that the step is not the cause.
+        let mut last_failure: Option<(f64, f64)> = None;
         loop {
-            match self.run_chunk(target_s) {
+            let err = match self.run_chunk(target_s) {
                 Ok(()) => {
                     self.restore_cfl_when_calm();
                     return Ok(());
                 }
-                Err(SolverError::BlowUp {
+                Err(e) => e,
+            };
+            let SolverError::BlowUp {
+                time_s,
+                step,
+                health,
+                culprits,
+                ..
+            } = err
+            else {
+                return Err(err);
+            };
+            let failed_dt = self.last_dt_s;
+            let recurs = last_failure.is_some_and(|(t, dt)| (time_s - t).abs() <= dt);
+            if recurs || tries >= MAX_RECOVERIES_PER_CHUNK {
+                return Err(SolverError::BlowUp {
                     time_s,
                     step,
                     health,
-                }) if tries < MAX_RECOVERIES_PER_CHUNK => {
-                    tries += 1;
-                    self.clean_chunks = 0;
-                    self.copy_state(&self.buffers.snapshot, &self.buffers.a);
-                    (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
-                    self.flume.clone_from(&saved_flume);
-                    self.params.cfl *= 0.5;
-                    self.gpu.queue.write_buffer(
-                        &self.buffers.params,
-                        0,
-                        bytemuck::bytes_of(&self.params),
-                    );
-                    log::warn!(
-                        "blow-up at t = {time_s:.6} s (step {step}): {health}; restored t = {:.6} s, retrying with CFL {}",
-                        self.time_s,
-                        self.params.cfl
-                    );
-                    self.recoveries.push(Recovery {
-                        failed_at_s: time_s,
-                        health,
-                        restored_to_s: self.time_s,
-                        cfl: f64::from(self.params.cfl),
-                    });
-                }
-                Err(e) => return Err(e),
+                    culprits,
+                    recurring_cfl: recurs.then_some(f64::from(self.params.cfl)),
+                });
             }
+            last_failure = Some((time_s, failed_dt));
+            tries += 1;
+            self.clean_chunks = 0;
+            self.copy_state(&self.buffers.snapshot, &self.buffers.a);
+            (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
+            self.flume.clone_from(&saved_flume);
+            self.params.cfl *= 0.5;
+            self.gpu
+                .queue
+                .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+            log::warn!(
+                "blow-up at t = {time_s:.6} s (step {step}): {health}; worst particles: {}; restored t = {:.6} s, retrying with CFL {}",
+                health::list(&culprits),
+                self.time_s,
+                self.params.cfl
+            );
+            self.recoveries.push(Recovery {
+                failed_at_s: time_s,
+                health,
+                restored_to_s: self.time_s,
+                cfl: f64::from(self.params.cfl),
+            });
         }
     }
 
@@ -453,13 +450,18 @@ impl Simulation {
             self.steps += u64::from(state.steps);
             self.last_dt_s = f64::from(state.last_dt);
             self.dt_taken = state.dt_taken;
-            let health = Health(state.status);
+            let mut health = Health(state.status);
+            if state.excluded > self.max_excluded {
+                health.0 |= Health::MANY_EXCLUDED;
+            }
             if !health.is_ok() {
                 self.time_s += f64::from(state.t_rel);
                 return Err(SolverError::BlowUp {
                     time_s: self.time_s,
                     step: self.steps,
                     health,
+                    culprits: self.culprits(&state)?,
+                    recurring_cfl: None,
                 });
             }
             let reached = state.t_rel >= state.t_target;
@@ -473,13 +475,47 @@ impl Simulation {
             } else {
                 self.time_s + advanced
             };
+            let rest = self.rest_densities();
             if let Some(f) = &mut self.flume {
                 f.eroded_particles += u64::from(state.eroded);
                 f.parked_particles += u64::from(state.parked);
+                f.excluded_particles += u64::from(state.excluded);
+                f.excluded_sediment += u64::from(state.excluded_sediment);
+                let logged = (state.excluded as usize).min(state.excluded_log.len());
+                let excluded = state.excluded_log[..logged]
+                    .iter()
+                    .map(|e| health::from_log(&self.case, &rest, e));
+                self.exclusion_log.note(
+                    self.time_s,
+                    state.excluded,
+                    excluded,
+                    f.excluded_particles,
+                );
             }
             self.feed_inlet(advanced)?;
         }
         Ok(())
+    }
+
+    /// The particles to name in a blow-up report: those excluded in the failed chunk, then
+    /// the moving ones furthest from health, 8 in all.
+    fn culprits(&self, state: &StepState) -> Result<Vec<Culprit>, SolverError> {
+        const NAMED: usize = 8;
+        let rest = self.rest_densities();
+        let logged = (state.excluded as usize).min(state.excluded_log.len());
+        let mut out: Vec<Culprit> = state.excluded_log[..logged]
+            .iter()
+            .map(|e| health::from_log(&self.case, &rest, e))
+            .collect();
+        let particles = self.read_particles()?;
+        let worst = health::worst_particles(&self.case, &rest, &particles, NAMED);
+        out.extend(worst.into_iter().take(NAMED.saturating_sub(out.len())));
+        Ok(out)
+    }
+
+    /// Rest density of each GPU phase (walls and parked particles included), kg/m3.
+    fn rest_densities(&self) -> Vec<f64> {
+        self.derived.phases.iter().map(|p| p.rho0).collect()
     }
 
     /// Fills the inlet columns due after `span_s` more of inflow with parked particles.
@@ -551,7 +587,7 @@ impl Simulation {
     /// non-finite discharge, one whose inlet velocity passes `MAX_INLET_MACH` c0, and a case
     /// without an open flume.
     pub fn set_boundary_conditions(&mut self, bc: BoundaryConditions) -> Result<(), SolverError> {
-        let c0 = f64::from(self.params.c0);
+        let c0 = self.derived.c0;
         let Some(f) = &mut self.flume else {
             return Err(SolverError::InvalidParameter {
                 name: "inflow",
@@ -565,8 +601,8 @@ impl Simulation {
                 reason: format!("must be a finite discharge >= 0 m3/s, got {q}"),
             });
         }
-        let u = crate::simulation::inlet_velocity(&f.config, q);
-        if u > MAX_INLET_MACH * c0 {
+        let u = inlet_velocity(&f.config, q);
+        if q > max_inflow_m3_per_s(&f.config, c0) {
             return Err(SolverError::InvalidParameter {
                 name: "inflow",
                 reason: format!(
@@ -789,6 +825,8 @@ impl Simulation {
                 eroded_rate_kg_per_s: rate,
                 parked_particles: f.parked_particles,
                 starved_particles: f.starved_particles,
+                excluded_particles: f.excluded_particles,
+                excluded_sediment: f.excluded_sediment,
             });
         }
         Ok(obs)
@@ -862,7 +900,13 @@ fn sim_params(
         dt_visc: dt_visc as f32,
         // A step a million times below the acoustic one means the state has gone bad.
         dt_min: (1e-6 * h / derived.c0) as f32,
-        rho_ratio_max: RHO_RATIO_MAX,
+        // An open flume excludes a free particle beyond this (store_state.wgsl); in a closed
+        // tank it is a runaway.
+        rho_ratio_max: if case.open_flume.is_some() {
+            RHO_RATIO_EXCLUDE
+        } else {
+            RHO_RATIO_MAX
+        },
         vertical_axis: (d - 1) as u32,
         n_probes,
         euler_every: match case.numerics.integrator {

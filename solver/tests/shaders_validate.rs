@@ -2,7 +2,7 @@
 //! workgroup size match the WGSL, and the Rust mirrors of WGSL structs have naga's layout.
 
 use flume_solver::gpu::params::{
-    Extremes, FlumeGpu, PhaseParams, ScanInfo, SedimentGpu, SimParams, StepState,
+    ExcludedParticle, Extremes, FlumeGpu, PhaseParams, ScanInfo, SedimentGpu, SimParams, StepState,
 };
 use flume_solver::gpu::stage::Access;
 use flume_solver::stages::ALL;
@@ -265,8 +265,14 @@ fn rust_mirrors_have_the_wgsl_layout() {
         dt_prev,
         dt_taken,
         eroded,
-        parked
+        parked,
+        excluded,
+        excluded_sediment,
+        excluded_log
     );
+    let (m, size) = wgsl_layout(&module, "ExcludedParticle");
+    assert_eq!(size as usize, size_of::<ExcludedParticle>());
+    same!(ExcludedParticle, m, id, phase, x, y, u, v, rho);
 
     let observe = ALL
         .iter()

@@ -112,6 +112,11 @@ impl Recorder {
 
     /// Writes to a temporary name first, so a crash never leaves a truncated snapshot behind.
     pub fn snapshot(&self, sim: &Simulation, name: &str) -> Result<()> {
+        self.snapshot_marked(sim, name, &[])
+    }
+
+    /// A snapshot whose `culprit` field is 1 for the particles of ids `marked`.
+    pub fn snapshot_marked(&self, sim: &Simulation, name: &str, marked: &[u32]) -> Result<()> {
         let particles = sim
             .read_particles()
             .context("cannot read the particles back from the GPU")?;
@@ -128,7 +133,7 @@ impl Recorder {
         );
         let file =
             File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
-        vtk::write_particles(BufWriter::new(file), &title, &particles, &regions)
+        vtk::write_particles(BufWriter::new(file), &title, &particles, &regions, marked)
             .and_then(|()| fs::rename(&tmp, &path))
             .with_context(|| format!("cannot write {}", path.display()))
     }

@@ -12,11 +12,14 @@ use std::io::{self, Write};
 /// held flag and id. `regions` are the solver's region words in id order (region 1-5 of the
 /// scour model, 0 for walls, plus 256 when held fixed); missing entries count as 0.
 /// `title` goes on the header's comment line (VTK allows at most 255 characters, no newline).
+/// When `marked` names ids (the particles a blow-up report names), a `culprit` field is 1 for
+/// them and 0 elsewhere.
 pub fn write_particles<W: Write>(
     mut w: W,
     title: &str,
     particles: &Particles,
     regions: &[u32],
+    marked: &[u32],
 ) -> io::Result<()> {
     let n = particles.len();
     let count = i32::try_from(n)
@@ -82,6 +85,13 @@ pub fn write_particles<W: Write>(
         put_i32s(&mut w, &[id as i32])?;
     }
     writeln!(w)?;
+    if !marked.is_empty() {
+        writeln!(w, "SCALARS culprit int 1\nLOOKUP_TABLE default")?;
+        for id in &particles.ids {
+            put_i32s(&mut w, &[i32::from(marked.contains(id))])?;
+        }
+        writeln!(w)?;
+    }
     Ok(())
 }
 
@@ -148,7 +158,7 @@ mod tests {
     #[test]
     fn binary_layout_is_big_endian_legacy_3_0() {
         let mut buf = Vec::new();
-        write_particles(&mut buf, "test t=0.5 s", &two_particles(), &[0, 257]).unwrap();
+        write_particles(&mut buf, "test t=0.5 s", &two_particles(), &[0, 257], &[]).unwrap();
         let mut b: &[u8] = &buf;
 
         assert_eq!(take_line(&mut b), "# vtk DataFile Version 3.0");
@@ -204,7 +214,15 @@ mod tests {
     #[test]
     fn title_cannot_break_the_header() {
         let mut buf = Vec::new();
-        write_particles(&mut buf, "two\nlines", &Particles::default(), &[]).unwrap();
+        write_particles(&mut buf, "two\nlines", &Particles::default(), &[], &[]).unwrap();
         assert!(buf.starts_with(b"# vtk DataFile Version 3.0\ntwolines\nBINARY\n"));
+    }
+
+    #[test]
+    fn a_blow_up_marks_the_particles_it_names() {
+        let mut buf = Vec::new();
+        write_particles(&mut buf, "failed", &two_particles(), &[], &[1]).unwrap();
+        let tail = b"SCALARS culprit int 1\nLOOKUP_TABLE default\n\0\0\0\0\0\0\0\x01\n";
+        assert!(buf.ends_with(tail), "no culprit field marking id 1 alone");
     }
 }

@@ -105,6 +105,23 @@ pub const DIFFUSION_NONE: u32 = 0;
 pub const DIFFUSION_MOLTENI: u32 = 1;
 pub const DIFFUSION_FOURTAKAS: u32 = 2;
 
+/// Entries of `StepState::excluded_log`; mirrors `EXCLUDED_LOG_LEN` in step_state.wgsl.
+pub const EXCLUDED_LOG_LEN: usize = 8;
+
+/// Mirrors `ExcludedParticle` in `shaders/common/step_state.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct ExcludedParticle {
+    pub id: u32,
+    pub phase: u32,
+    pub x: f32,
+    pub y: f32,
+    pub u: f32,
+    pub v: f32,
+    pub rho: f32,
+    pub pad: u32,
+}
+
 /// Mirrors `StepState` in `shaders/common/step_state.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
@@ -121,6 +138,10 @@ pub struct StepState {
     pub dt_taken: f32,
     pub eroded: u32,
     pub parked: u32,
+    pub excluded: u32,
+    pub excluded_sediment: u32,
+    pub pad: [u32; 2],
+    pub excluded_log: [ExcludedParticle; EXCLUDED_LOG_LEN],
 }
 
 impl StepState {
@@ -141,6 +162,10 @@ impl StepState {
             dt_taken,
             eroded: 0,
             parked: 0,
+            excluded: 0,
+            excluded_sediment: 0,
+            pad: [0; 2],
+            excluded_log: [ExcludedParticle::zeroed(); EXCLUDED_LOG_LEN],
         }
     }
 }
