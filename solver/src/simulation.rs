@@ -31,7 +31,8 @@ pub enum SolverError {
     #[error(
         "simulation blew up at t = {time_s:.6} s (step {step}): {health}{}; worst particles: {}",
         recurring_cfl.map_or(String::new(), |c| format!(
-            "; it recurred at the same simulated time with CFL {}: not a time-step problem", c as f32
+            "; it recurred at about the same simulated time at every CFL down to {}: not a time-step problem",
+            c as f32
         )),
         health::list(culprits)
     )]
@@ -309,9 +310,11 @@ impl Simulation {
         let saved_flume = self.flume.clone();
         self.copy_state(&self.buffers.a, &self.buffers.snapshot);
         let mut tries = 0;
-        // When and with what step the last try failed: a retry that fails at the same time
-        // with a smaller step shows that the step is not the cause.
-        let mut last_failure: Option<(f64, f64)> = None;
+        // When the first try failed, and whether every retry failed at about the same time:
+        // an unstable step fails after about as many steps whatever their length, so halving
+        // the step moves the failure; a failure that stays put is not the step's doing.
+        let mut first_failure: Option<(f64, f64)> = None;
+        let mut same_time = true;
         loop {
             let err = match self.run_chunk(target_s) {
                 Ok(()) => {
@@ -330,18 +333,20 @@ impl Simulation {
             else {
                 return Err(err);
             };
-            let failed_dt = self.last_dt_s;
-            let recurs = last_failure.is_some_and(|(t, dt)| (time_s - t).abs() <= dt);
-            if recurs || tries >= MAX_RECOVERIES_PER_CHUNK {
+            let (first_s, tolerance_s) = *first_failure.get_or_insert_with(|| {
+                // One step, or a tenth of the time from the restored state to the failure.
+                (time_s, self.last_dt_s.max(0.1 * (time_s - saved.0)))
+            });
+            same_time &= (time_s - first_s).abs() <= tolerance_s;
+            if tries >= MAX_RECOVERIES_PER_CHUNK {
                 return Err(SolverError::BlowUp {
                     time_s,
                     step,
                     health,
                     culprits,
-                    recurring_cfl: recurs.then_some(f64::from(self.params.cfl)),
+                    recurring_cfl: same_time.then_some(f64::from(self.params.cfl)),
                 });
             }
-            last_failure = Some((time_s, failed_dt));
             tries += 1;
             self.clean_chunks = 0;
             self.copy_state(&self.buffers.snapshot, &self.buffers.a);
