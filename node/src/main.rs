@@ -15,6 +15,7 @@ mod observed;
 mod output;
 mod pacer;
 mod play;
+mod progress;
 mod replay;
 mod ros_args;
 mod run;

@@ -3,16 +3,13 @@
 use crate::cli::SimulateArgs;
 use crate::inflow::InflowSeries;
 use crate::output::{bed_plot, recorder::Recorder};
+use crate::progress;
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation, SolverError};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
-
-/// The progress bar counts simulated microseconds: an integer position with ample resolution.
-const TICKS_PER_S: f64 = 1e6;
 
 pub fn run(args: &SimulateArgs) -> Result<()> {
     // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
@@ -62,15 +59,15 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     );
 
-    let progress = progress_bar(end_s);
-    progress.set_message(format!("t = 0/{end_s} s"));
+    let bar = progress::bar(end_s);
+    bar.set_message(format!("t = 0/{end_s} s"));
     let started = Instant::now();
     let mut last = recorder.record(&sim, 0)?;
     let initial_profile = last.profile.clone();
     for k in 1..=intervals {
         let target_s = (k as f64 * interval_s).min(end_s);
         if let Err(err) = advance(&mut sim, inflow.as_ref(), target_s) {
-            progress.abandon();
+            bar.abandon();
             if let Some(SolverError::BlowUp { culprits, .. }) = err.downcast_ref::<SolverError>() {
                 // The broken state shows where it went wrong; losing it would waste the run.
                 // Its `culprit` field marks the particles the error names.
@@ -87,14 +84,14 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
         last = recorder.record(&sim, k)?;
         let wall = started.elapsed().as_secs_f64();
-        progress.set_position((sim.time_s() * TICKS_PER_S) as u64);
-        progress.set_message(format!(
+        progress::set_time(&bar, sim.time_s());
+        bar.set_message(format!(
             "t = {:.4}/{end_s} s, {:.0} steps/s",
             sim.time_s(),
             sim.steps() as f64 / wall
         ));
     }
-    progress.finish_and_clear();
+    bar.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
     if recorder.has_bed_profile() {
         let path = out_dir.join("bed.png");
@@ -155,17 +152,6 @@ fn print_case(path: &Path, case: &Case, sim: &Simulation) {
         "h = {:.6} m, c0 = {:.3} m/s, dp = {} m",
         derived.h, derived.c0, case.numerics.dp_m
     );
-}
-
-fn progress_bar(end_s: f64) -> ProgressBar {
-    let bar = ProgressBar::new((end_s * TICKS_PER_S) as u64);
-    // A template typo is a programming error, caught the first time anyone runs simulate.
-    if let Ok(style) =
-        ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {msg}, ETA {eta}")
-    {
-        bar.set_style(style);
-    }
-    bar
 }
 
 fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {

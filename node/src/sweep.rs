@@ -4,18 +4,15 @@
 
 use crate::cli::SweepArgs;
 use crate::output::{csv::field, sweep_plot};
+use crate::progress;
 use crate::table::{Table, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::observe::FlumeObservation;
 use flume_solver::{Case, GpuContext, Simulation};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
-
-/// The progress bar counts simulated microseconds, as simulate's does.
-const TICKS_PER_S: f64 = 1e6;
 
 const USAGE: &str = "expected KEY=V1,V2,..., e.g. phases.1.sediment.ks_over_d50=1,2,3";
 
@@ -227,7 +224,7 @@ fn run_case(
     let interval_s = case.time.output_interval_s;
     // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
     let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;
-    let bar = progress_bar(end_s);
+    let bar = progress::bar(end_s);
     let started = Instant::now();
     for k in 1..=intervals {
         let target_s = (k as f64 * interval_s).min(end_s);
@@ -239,7 +236,7 @@ fn run_case(
             return Err(e.into());
         }
         row.time_s = target_s;
-        bar.set_position((target_s * TICKS_PER_S) as u64);
+        progress::set_time(&bar, target_s);
         bar.set_message(format!(
             "{label}: t = {target_s:.4}/{end_s} s, {:.0} s wall",
             started.elapsed().as_secs_f64()
@@ -251,17 +248,6 @@ fn run_case(
         .context("cannot read the final observations")?;
     row.recoveries = obs.recoveries;
     obs.flume.context("the open flume reported no eroded mass")
-}
-
-fn progress_bar(end_s: f64) -> ProgressBar {
-    let bar = ProgressBar::new((end_s * TICKS_PER_S) as u64);
-    // A template typo is a programming error, caught the first time anyone runs a sweep.
-    if let Ok(style) =
-        ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {msg}, ETA {eta}")
-    {
-        bar.set_style(style);
-    }
-    bar
 }
 
 /// "t = 18 s", or the range when the runs stop at different times (a sweep of time.end_s).

@@ -8,17 +8,7 @@ mod common;
 use flume_solver::case::Particles;
 use flume_solver::{BoundaryConditions, Case, Simulation};
 
-/// The ULBRA flume at CI size: dp = 1 cm (bed 5 particles deep, the inlet 2 high), a reservoir
-/// of 2,500 parked particles.
-fn ulbra_ci() -> Case {
-    let mut c = Case::from_path(&common::case_path("../launch_configs/ulbra_flume.yaml"))
-        .expect("case parses");
-    c.numerics.dp_m = 0.01;
-    if let Some(f) = c.open_flume.as_mut() {
-        f.reservoir_particles = 2500;
-    }
-    c
-}
+use common::ulbra_ci;
 
 const SAND: u32 = 2;
 const WATER: u32 = 1;

@@ -10,13 +10,10 @@ use flume_solver::{Case, Health, Simulation, SolverError};
 
 const WATER: u32 = 1;
 
-/// The ULBRA flume at CI size (dp = 1 cm), with no inflow unless a test sets one.
+/// The ULBRA flume at CI size with no inflow: nothing moves but what a test sets moving.
 fn ulbra_ci_still() -> Case {
-    let mut c = Case::from_path(&common::case_path("../launch_configs/ulbra_flume.yaml"))
-        .expect("case parses");
-    c.numerics.dp_m = 0.01;
+    let mut c = common::ulbra_ci();
     if let Some(f) = c.open_flume.as_mut() {
-        f.reservoir_particles = 2500;
         f.inflow_m3_per_s = 0.0;
     }
     c

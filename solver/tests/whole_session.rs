@@ -5,25 +5,16 @@
 
 mod common;
 
+use common::ulbra_ci;
+use flume_solver::Simulation;
 use flume_solver::case::{Parking, Particles, parked_phase};
 use flume_solver::observe::{FlumeObservation, Observations};
-use flume_solver::{Case, Simulation};
 use std::time::Instant;
 
 const WATER: u32 = 1;
 const SAND: u32 = 2;
 /// The sand bed's top at the start, m.
 const BED_M: f64 = 0.055;
-
-fn ulbra_ci() -> Case {
-    let mut c = Case::from_path(&common::case_path("../launch_configs/ulbra_flume.yaml"))
-        .expect("case parses");
-    c.numerics.dp_m = 0.01;
-    if let Some(f) = c.open_flume.as_mut() {
-        f.reservoir_particles = 2500;
-    }
-    c
-}
 
 fn count(p: &Particles, phase: u32) -> u64 {
     (0..p.len()).filter(|&i| p.phase(i) == phase).count() as u64

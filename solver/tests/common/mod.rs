@@ -31,6 +31,18 @@ pub fn gpu() -> Option<Arc<GpuContext>> {
     .clone()
 }
 
+/// The ULBRA flume at CI size: dp = 1 cm (the bed 5 particles deep, the inlet 2 high), a
+/// reservoir of 2,500 parked particles.
+pub fn ulbra_ci() -> flume_solver::Case {
+    let mut c = flume_solver::Case::from_path(&case_path("../launch_configs/ulbra_flume.yaml"))
+        .expect("case parses");
+    c.numerics.dp_m = 0.01;
+    if let Some(f) = c.open_flume.as_mut() {
+        f.reservoir_particles = 2500;
+    }
+    c
+}
+
 pub fn case_path(name: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(name)
 }
