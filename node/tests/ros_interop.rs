@@ -23,8 +23,11 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
     let dir = std::env::temp_dir().join(format!("flume-ros-interop-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let out_dir = dir.join("out");
-    // The twin runs to 0.5 s of simulated time behind sensors that speak for 4 s; on a
-    // software adapter it lags them, so its lag and decimation show in /diagnostics.
+    // The twin runs to 3 s of simulated time behind sensors that speak for 4 s; on a
+    // software adapter it lags them, so its lag and decimation show in /diagnostics. Its
+    // simulated time never passes the sensors', so it runs at least 3 s of wall time: the
+    // peer's bad samples (at 1.3 s) reach a /diagnostics (1 Hz) before it ends. At 0.5 s a
+    // twin that kept up ended before that, and the refusal counts were never seen.
     let node = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
         .args([
             "run",
@@ -35,7 +38,7 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
             "--no-replay",
             "--wait-for-sensors",
             "--until",
-            "0.5",
+            "3.0",
             "--out",
             out_dir.to_str().expect("utf-8"),
             "--ros-args",
@@ -59,7 +62,7 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
     let node_log =
         String::from_utf8_lossy(&node.stdout).to_string() + &String::from_utf8_lossy(&node.stderr);
     assert!(node.status.success(), "the twin failed:\n{node_log}");
-    assert!(node_log.contains("reached t = 0.500 s"), "{node_log}");
+    assert!(node_log.contains("reached t = 3.000 s"), "{node_log}");
     // Once the twin is gone the peer has seen all it will: give the last samples a moment
     // in flight, then stop it.
     std::thread::sleep(std::time::Duration::from_secs(2));
