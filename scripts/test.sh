@@ -25,4 +25,16 @@ fi
 if ! python3 -c "import rerun" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check rerun-sdk==0.41.0
 fi
-cargo test --release --workspace "$@"
+# cargo's output ends with the doc-test runs ("0 passed"): a last line sums the whole suite.
+log="$(mktemp)"
+status=0
+cargo test --release --workspace "$@" 2>&1 | tee "$log" || status=$?
+awk '/^test result:/ {
+  for (i = 2; i <= NF; i++) {
+    if ($i == "passed;") p += $(i - 1)
+    if ($i == "failed;") f += $(i - 1)
+    if ($i == "ignored;") s += $(i - 1)
+  }
+} END { printf "%d passed, %d failed, %d skipped\n", p, f, s }' "$log"
+rm -f "$log"
+exit "$status"
