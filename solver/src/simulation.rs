@@ -480,7 +480,12 @@ impl Simulation {
             } else {
                 self.time_s + advanced
             };
-            let rest = self.rest_densities();
+            // Only a chunk with exclusions has particles to name.
+            let rest = if state.excluded > 0 {
+                self.rest_densities()
+            } else {
+                Vec::new()
+            };
             if let Some(f) = &mut self.flume {
                 f.eroded_particles += u64::from(state.eroded);
                 f.parked_particles += u64::from(state.parked);

@@ -5,7 +5,7 @@
 
 mod common;
 
-use flume_solver::case::{Particles, parked_phase};
+use flume_solver::case::{self, parked_phase};
 use flume_solver::{Case, Health, Simulation, SolverError};
 
 const WATER: u32 = 1;
@@ -19,17 +19,19 @@ fn ulbra_ci_still() -> Case {
     c
 }
 
-/// The case's particles with the parked particle of the lowest id turned into a water drop at
-/// `at`, moving at `velocity`; returns them and the drop's id.
-fn with_drop(case: &Case, sim: &Simulation, at: [f32; 2], velocity: [f32; 2]) -> (Particles, u32) {
-    let mut p = sim.initial_particles().clone();
+/// A simulation of `case` whose parked particle of the lowest id is turned into a water drop
+/// at `at`, moving at `velocity`; and the drop's id.
+fn with_drop(case: &Case, at: [f32; 2], velocity: [f32; 2]) -> Option<(Simulation, u32)> {
+    let gpu = common::gpu()?;
+    let mut p = case::generate(case, &case::derive(case));
     let parked = parked_phase(case);
     let id = (0..p.len())
         .find(|&i| p.phase(i) == parked)
         .expect("a parked particle");
     p.positions[id] = [at[0], at[1], 0.0, f32::from_bits(WATER)];
     p.vel_rho[id] = [velocity[0], velocity[1], 0.0, 1000.0];
-    (p, id as u32)
+    let sim = Simulation::from_particles(gpu, case, p).expect("builds");
+    Some((sim, id as u32))
 }
 
 /// One drop falling at 5 m/s (Mach 0.5 with c0 = 10 m/s) onto the floor of the empty collector
@@ -40,12 +42,10 @@ fn with_drop(case: &Case, sim: &Simulation, at: [f32; 2], velocity: [f32; 2]) ->
 #[test]
 fn a_lone_drop_hitting_a_wall_is_excluded_and_the_run_goes_on() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
     let c = ulbra_ci_still();
-    let probe = Simulation::new(std::sync::Arc::clone(&gpu), &c).expect("case builds");
-    let (particles, id) = with_drop(&c, &probe, [2.35, 0.06], [0.0, -5.0]);
-    drop(probe);
-    let mut sim = Simulation::from_particles(gpu, &c, particles).expect("builds");
+    let Some((mut sim, id)) = with_drop(&c, [2.35, 0.06], [0.0, -5.0]) else {
+        return;
+    };
     let parked_at_start = sim.flume().expect("flume").parked_particles;
     sim.advance_to(0.1).expect("a splash does not stop the run");
     let obs = sim.observe().expect("observes");
@@ -70,12 +70,10 @@ fn a_lone_drop_hitting_a_wall_is_excluded_and_the_run_goes_on() {
 #[test]
 fn a_drop_at_the_speed_of_the_pit_splash_is_neither_excluded_nor_fatal() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
     let c = ulbra_ci_still();
-    let probe = Simulation::new(std::sync::Arc::clone(&gpu), &c).expect("case builds");
-    let (particles, id) = with_drop(&c, &probe, [2.35, 0.04], [0.0, -1.2]);
-    drop(probe);
-    let mut sim = Simulation::from_particles(gpu, &c, particles).expect("builds");
+    let Some((mut sim, id)) = with_drop(&c, [2.35, 0.04], [0.0, -1.2]) else {
+        return;
+    };
     sim.advance_to(0.1).expect("runs");
     let obs = sim.observe().expect("observes");
     let f = obs.flume.expect("flume");
@@ -122,12 +120,10 @@ fn an_unstable_step_in_a_flume_is_still_a_blow_up() {
 #[test]
 fn a_failure_at_the_same_time_at_a_smaller_step_is_reported_as_not_a_time_step_problem() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
     let c = ulbra_ci_still();
-    let probe = Simulation::new(std::sync::Arc::clone(&gpu), &c).expect("case builds");
-    let (particles, id) = with_drop(&c, &probe, [1.5, 0.2], [f32::NAN, 0.0]);
-    drop(probe);
-    let mut sim = Simulation::from_particles(gpu, &c, particles).expect("builds");
+    let Some((mut sim, id)) = with_drop(&c, [1.5, 0.2], [f32::NAN, 0.0]) else {
+        return;
+    };
     let err = sim.advance_to(0.05).expect_err("a NaN particle cannot run");
     let text = err.to_string();
     eprintln!("{text}");
