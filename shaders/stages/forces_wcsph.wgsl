@@ -23,7 +23,7 @@ fn momentum_pressure(rho: f32, phase: u32) -> f32 {
 }
 
 // A particle's viscous stress over rho^2 from the rheology pass's (xx, xy, xz, yy) and
-// (yz, zz, mu, region) texels.
+// (yz, zz, mu, region word) texels.
 fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
     let a = textureLoad(stress_a, texel(i), 0);
     let b = textureLoad(stress_b, texel(i), 0);

@@ -3,7 +3,9 @@
 // (Eqs. 27-31), the bed-surface test (Eq. 26), the Shields criterion with the nearest water
 // particle (Eqs. 16-25), the concentration (Eq. 32), the region of Figure 2 and its apparent
 // viscosity (Eqs. 15, 33); then the viscous stress tau = 2 mu eps that the force pass
-// differentiates. Reference: solver/src/physics/sediment/pass.rs.
+// differentiates. Un-yielded sediment is held (REGION_HELD); in the Drucker-Prager mode a held
+// particle stays held here unless Shields makes it bed load, and the yield_release stage that
+// follows releases it. Reference: solver/src/physics/sediment/pass.rs.
 
 @group(0) @binding(1) var positions: texture_2d<f32>;
 @group(0) @binding(2) var vel_rho: texture_2d<f32>;
@@ -136,8 +138,13 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
                 region = REGION_UNYIELDED;
             }
         } else {
+            // Read before this thread writes it; no other thread writes this id's word.
+            let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
             if (bed_load) {
                 region = REGION_BED_LOAD;
+            } else if (held_before) {
+                // Only the yield_release stage, by the stress of the moving neighbours.
+                region = REGION_UNYIELDED;
             } else {
                 let sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
                 region = select(REGION_UNYIELDED, REGION_YIELDED, sqrt_j2 > tau_y);
@@ -153,11 +160,14 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         mu = min(mu, sd.mu_max);
     }
-    let held = sd.shields_only != 0u && region == REGION_UNYIELDED;
-    let t = select(2.0 * mu, 0.0, held) * eps;
+    // Shields-only holds carry no stress; Drucker-Prager holds keep theirs (hold.rs).
+    let held = region == REGION_UNYIELDED;
+    let t = select(2.0 * mu, 0.0, held && sd.shields_only != 0u) * eps;
+    let word = region | select(0u, REGION_HELD, held);
     textureStore(stress_a, texel(i), vec4<f32>(t[0].x, t[1].x, t[2].x, t[1].y));
-    textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(region)));
+    // The whole region word: yield_release reads which neighbours this pass held.
+    textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(word)));
     // By particle id: the integrators, the probes and the host each see the particles in a
     // different order.
-    regions[ids[i]] = region | select(0u, REGION_HELD, held);
+    regions[ids[i]] = word;
 }

@@ -35,8 +35,12 @@ pub struct SphPipeline {
     forces_correct: Stage,
     rheology_predict: Stage,
     rheology_correct: Stage,
+    release_predict: Stage,
+    release_correct: Stage,
     /// Viscous stress from the rheology pass before each force pass.
     multiphase: bool,
+    /// Held sediment released by Drucker-Prager after each rheology pass.
+    yield_release: bool,
     dt_update: Stage,
     symplectic_predictor: Stage,
     symplectic_corrector: Stage,
@@ -54,6 +58,7 @@ impl SphPipeline {
         divisions: u32,
         verlet: bool,
         multiphase: bool,
+        yield_release: bool,
     ) -> SphPipeline {
         let d = &gpu.device;
         let width = f64::from(2 * divisions + 1);
@@ -93,7 +98,18 @@ impl SphPipeline {
                 &stages::RHEOLOGY,
                 &[stencil[0], stencil[1], ("BEFORE_DT", 0.0)],
             ),
+            release_predict: Stage::new(
+                d,
+                &stages::YIELD_RELEASE,
+                &[stencil[0], stencil[1], ("BEFORE_DT", 1.0)],
+            ),
+            release_correct: Stage::new(
+                d,
+                &stages::YIELD_RELEASE,
+                &[stencil[0], stencil[1], ("BEFORE_DT", 0.0)],
+            ),
             multiphase,
+            yield_release,
             dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
             symplectic_predictor: Stage::new(d, &stages::SYMPLECTIC_PREDICTOR, &[]),
             symplectic_corrector: Stage::new(d, &stages::SYMPLECTIC_CORRECTOR, &[]),
@@ -121,7 +137,7 @@ pub struct GpuBuffers {
     /// A copy of `a` taken at the start of each chunk, restored after a blow-up.
     pub snapshot: StateBuffers,
     pub c: StateTextures,
-    /// The rheology pass's viscous stress, (xx, xy, xz, yy) and (yz, zz, mu, region), in cell
+    /// The rheology pass's viscous stress, (xx, xy, xz, yy) and (yz, zz, mu, region word), in cell
     /// order, and region words (region | REGION_HELD) by particle id.
     pub stress_a: wgpu::TextureView,
     pub stress_b: wgpu::TextureView,
@@ -265,6 +281,8 @@ pub struct Bindings {
     forces_correct: wgpu::BindGroup,
     rheology_predict: wgpu::BindGroup,
     rheology_correct: wgpu::BindGroup,
+    release_predict: wgpu::BindGroup,
+    release_correct: wgpu::BindGroup,
     dt_update: wgpu::BindGroup,
     symplectic_predictor: wgpu::BindGroup,
     symplectic_corrector: wgpu::BindGroup,
@@ -368,7 +386,35 @@ impl SphPipeline {
                     &g.b_ids,
                 ],
             ),
+            release_predict: self.release_predict.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.cell_starts,
+                    &g.state,
+                    &g.stress_a,
+                    &g.stress_b,
+                    &g.regions,
+                    &g.b_ids,
+                ],
+            ),
             rheology_correct: self.rheology_correct.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.c.positions,
+                    &g.c.vel_rho,
+                    &g.cell_starts,
+                    &g.state,
+                    &g.stress_a,
+                    &g.stress_b,
+                    &g.regions,
+                    &g.b_ids,
+                ],
+            ),
+            release_correct: self.release_correct.bind(
                 d,
                 &[
                     &g.params,
@@ -479,10 +525,7 @@ impl SphPipeline {
     pub fn record_step(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         self.record_sort(pass, b);
-        if self.multiphase {
-            self.rheology_predict
-                .record_items(pass, 0, &b.rheology_predict, n);
-        }
+        self.record_rheology(pass, b, true);
         self.forces_predict
             .record_items(pass, 0, &b.forces_predict, n);
         self.dt_update.record_items(pass, 0, &b.dt_update, 1);
@@ -492,10 +535,7 @@ impl SphPipeline {
         } else {
             self.symplectic_predictor
                 .record_items(pass, 0, &b.symplectic_predictor, n);
-            if self.multiphase {
-                self.rheology_correct
-                    .record_items(pass, 0, &b.rheology_correct, n);
-            }
+            self.record_rheology(pass, b, false);
             self.forces_correct
                 .record_items(pass, 0, &b.forces_correct, n);
             self.symplectic_corrector
@@ -503,13 +543,33 @@ impl SphPipeline {
         }
     }
 
+    /// The rheology pass and the release of held sediment, on the state at n (`predict`) or
+    /// at n + 1/2, when the case has them.
+    fn record_rheology(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings, predict: bool) {
+        let n = b.n_particles;
+        if !self.multiphase {
+            return;
+        }
+        let (rheology, bind) = if predict {
+            (&self.rheology_predict, &b.rheology_predict)
+        } else {
+            (&self.rheology_correct, &b.rheology_correct)
+        };
+        rheology.record_items(pass, 0, bind, n);
+        if self.yield_release {
+            let (release, bind) = if predict {
+                (&self.release_predict, &b.release_predict)
+            } else {
+                (&self.release_correct, &b.release_correct)
+            };
+            release.record_items(pass, 0, bind, n);
+        }
+    }
+
     /// Forces at the current state only (no integration): for tests against the CPU oracle.
     pub fn record_forces(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
-        if self.multiphase {
-            self.rheology_predict
-                .record_items(pass, 0, &b.rheology_predict, b.n_particles);
-        }
+        self.record_rheology(pass, b, true);
         self.forces_predict
             .record_items(pass, 0, &b.forces_predict, b.n_particles);
     }

@@ -216,12 +216,18 @@ impl Simulation {
         let verlet = matches!(case.numerics.integrator, Integrator::Verlet { .. });
         let flume = FlumeState::new(case, &particles);
         let multiphase = matches!(case.numerics.viscosity, Viscosity::Multiphase { .. });
+        let drucker_prager = case
+            .phases
+            .iter()
+            .filter_map(|p| p.sediment.as_ref())
+            .any(|s| s.criterion == YieldCriterion::DruckerPragerShields);
         let pipeline = SphPipeline::new(
             &gpu,
             case.dimension,
             divisions_of(case, derived.h),
             verlet,
             multiphase,
+            multiphase && drucker_prager,
         );
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
         let max_excluded = health::max_excluded_per_chunk(
@@ -704,9 +710,9 @@ impl Simulation {
         Ok(out)
     }
 
-    /// Region words of the last rheology pass, in id order: the region 1-5 of Figure 2 (0 for
-    /// walls, and for every particle when the case has no multiphase viscosity), plus 256 for
-    /// sediment held fixed in that pass.
+    /// Region words of the last rheology pass (and release of held sediment), in id order: the
+    /// region 1-5 of Figure 2 (0 for walls, and for every particle when the case has no
+    /// multiphase viscosity), plus 256 for sediment held fixed in that pass.
     pub fn regions(&self) -> Result<Vec<u32>, SolverError> {
         let n = self.particle_count() as u64;
         let raw = read_buffers(&self.gpu, &[(&self.buffers.regions, n * 4)])?;

@@ -174,6 +174,25 @@ pub const RHEOLOGY: StageSpec = StageSpec {
     workgroup: 64,
 };
 
+pub const YIELD_RELEASE: StageSpec = StageSpec {
+    name: "yield_release",
+    shader: "stages/yield_release.wgsl",
+    imports: NEIGHBOUR_PASS,
+    bindings: &[
+        ("params", 0, Uniform),
+        ("positions", 1, Texture),
+        ("vel_rho", 2, Texture),
+        ("cell_starts", 3, Read),
+        ("state", 4, ReadWrite),
+        ("stress_a", 5, Texture),
+        ("stress_b", 6, Texture),
+        ("regions", 7, ReadWrite),
+        ("ids", 8, Read),
+    ],
+    entry_points: &["yield_release"],
+    workgroup: 64,
+};
+
 pub const DT_UPDATE: StageSpec = StageSpec {
     name: "dt_update",
     shader: "stages/dt_update.wgsl",
@@ -287,6 +306,7 @@ pub const ALL: &[&StageSpec] = &[
     &REORDER,
     &FORCES_WCSPH,
     &RHEOLOGY,
+    &YIELD_RELEASE,
     &DT_UPDATE,
     &SYMPLECTIC_PREDICTOR,
     &SYMPLECTIC_CORRECTOR,

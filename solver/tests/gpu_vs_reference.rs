@@ -364,83 +364,107 @@ fn probe_interpolate_phase_fullness_matches_the_cpu() {
     }
 }
 
-/// The rheology pass and the multiphase force pass against `sediment::pass`: regions word for
-/// word, accelerations (pressure plus stress divergence) and density rates within 1e-4 of the
-/// largest, and the stable step with each particle's viscous limit.
+/// The rheology pass, the release of held sediment and the multiphase force pass against
+/// `sediment::pass` and `sediment::hold`: regions word for word, accelerations (pressure plus
+/// stress divergence) and density rates within 1e-4 of the largest, and the stable step with
+/// each particle's viscous limit. Two passes, the second starting from the holds of the first
+/// as a step starts from the last one's.
 fn check_rheology(c: Case, seed: u64) {
-    use flume_solver::physics::sediment::pass;
+    use flume_solver::physics::sediment::{hold, pass};
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     // Random velocities up to 0.3 m/s over a perturbed lattice: strain rates of tens per
     // second, bed shear stresses on both sides of the Shields threshold, yielded and
-    // un-yielded sediment.
-    let (sim, particles, params) = common::perturbed_sim(&gpu, &c, 0.3, seed);
-    let model = common::reference_sediment(&sim);
-    let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
-    let gpu_regions = sim.regions().expect("regions");
-    let rheology = pass::rheology_pass(&params, &model, &particles.positions, &particles.vel_rho);
-    let cpu_regions: Vec<u32> = rheology
-        .iter()
-        .map(|r| r.region | if r.held { 256 } else { 0 })
-        .collect();
-    // A comparison at a threshold (Shields, Drucker-Prager, c_v, the surface mass) may go
-    // either way under f32 rounding of sums taken in different orders; none did in this state.
-    let differ: Vec<usize> = (0..cpu_regions.len())
-        .filter(|&i| cpu_regions[i] != gpu_regions[i])
-        .collect();
-    assert!(
-        differ.is_empty(),
-        "{} regions differ, first: particle {} gpu {} cpu {}",
-        differ.len(),
-        differ[0],
-        gpu_regions[differ[0]],
-        cpu_regions[differ[0]]
-    );
-    let mut count = [0usize; 6];
-    for r in &cpu_regions {
-        count[(*r & 255) as usize] += 1;
-    }
-    let mut cpu = interaction::interact(&params, &particles.positions, &particles.vel_rho);
-    let stress =
-        pass::stress_divergence(&params, &particles.positions, &particles.vel_rho, &rheology);
-    for (f, s) in cpu.forces.iter_mut().zip(&stress) {
-        for k in 0..3 {
-            f[k] += s[k];
+    // un-yielded sediment. The lower three quarters of the bed are at rest, so that the first pass holds
+    // it and the release stage has held particles under moving ones to decide on.
+    let lattice = flume_solver::Simulation::new(std::sync::Arc::clone(&gpu), &c).expect("builds");
+    let mut particles = common::perturbed(&lattice, 0.3, seed);
+    let at_rest_below = 0.75 * c.fluid_blocks[0].max_m[1] as f32;
+    for i in 0..particles.len() {
+        if particles.phase(i) == 2 && particles.positions[i][1] < at_rest_below {
+            particles.vel_rho[i][..3].fill(0.0);
         }
     }
-    assert_close(
-        "multiphase acceleration",
-        &gpu_forces,
-        &cpu.forces,
-        c.dim(),
-        1e-4,
-    );
-    let drho: Vec<[f32; 4]> = gpu_forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
-    let drho_cpu: Vec<[f32; 4]> = cpu.forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
-    assert_close("multiphase density rate", &drho, &drho_cpu, 1, 1e-4);
-    let h = params.h;
-    let cpu_dt = cpu
-        .dt_limit
-        .iter()
-        .zip(&rheology)
-        .zip(&particles.vel_rho)
-        .map(|((&dt, r), v)| {
-            if r.mu > 0.0 {
-                dt.min(0.125 * h * h * v[3] / r.mu)
-            } else {
-                dt
+    let sim = flume_solver::Simulation::from_particles(gpu, &c, particles.clone()).expect("builds");
+    let params = common::reference_params(&sim);
+    let model = common::reference_sediment(&sim);
+    let (pos, vel) = (&particles.positions, &particles.vel_rho);
+    let mut held = vec![false; particles.len()];
+    let (mut released, mut count) = (0, [0usize; 6]);
+    for round in 1..=2 {
+        let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
+        let gpu_regions = sim.regions().expect("regions");
+        let mut rheology = pass::rheology_pass(&params, &model, pos, vel, &held);
+        let held_in_rheology: Vec<bool> = rheology.iter().map(|r| r.held).collect();
+        hold::release_pass(&params, &model, pos, vel, &mut rheology);
+        released += (0..rheology.len())
+            .filter(|&i| held_in_rheology[i] && !rheology[i].held)
+            .count();
+        let cpu_regions: Vec<u32> = rheology
+            .iter()
+            .map(|r| r.region | if r.held { 256 } else { 0 })
+            .collect();
+        // A comparison at a threshold (Shields, Drucker-Prager, c_v, the surface mass) may go
+        // either way under f32 rounding of sums taken in different orders; none did here.
+        let differ: Vec<usize> = (0..cpu_regions.len())
+            .filter(|&i| cpu_regions[i] != gpu_regions[i])
+            .collect();
+        assert!(
+            differ.is_empty(),
+            "round {round}: {} regions differ, first: particle {} gpu {} cpu {}",
+            differ.len(),
+            differ[0],
+            gpu_regions[differ[0]],
+            cpu_regions[differ[0]]
+        );
+        count = [0usize; 6];
+        for r in &cpu_regions {
+            count[(*r & 255) as usize] += 1;
+        }
+        let mut cpu = interaction::interact(&params, pos, vel);
+        let stress = pass::stress_divergence(&params, pos, vel, &rheology);
+        for (f, s) in cpu.forces.iter_mut().zip(&stress) {
+            for k in 0..3 {
+                f[k] += s[k];
             }
-        })
-        .fold(f32::INFINITY, f32::min);
-    assert!(
-        ((gpu_dt - cpu_dt) / cpu_dt).abs() < 1e-4,
-        "stable step: gpu {gpu_dt} cpu {cpu_dt}"
-    );
-    eprintln!(
-        "{}: regions (walls, 1-5) {count:?} agree; accelerations agree; stable step {gpu_dt:.3e} s",
-        c.name
-    );
-    // Every sediment region this test exists for occurs.
+        }
+        assert_close(
+            "multiphase acceleration",
+            &gpu_forces,
+            &cpu.forces,
+            c.dim(),
+            1e-4,
+        );
+        let drho: Vec<[f32; 4]> = gpu_forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
+        let drho_cpu: Vec<[f32; 4]> = cpu.forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
+        assert_close("multiphase density rate", &drho, &drho_cpu, 1, 1e-4);
+        let h = params.h;
+        let cpu_dt = cpu
+            .dt_limit
+            .iter()
+            .zip(&rheology)
+            .zip(vel)
+            .map(|((&dt, r), v)| {
+                if r.mu > 0.0 {
+                    dt.min(0.125 * h * h * v[3] / r.mu)
+                } else {
+                    dt
+                }
+            })
+            .fold(f32::INFINITY, f32::min);
+        assert!(
+            ((gpu_dt - cpu_dt) / cpu_dt).abs() < 1e-4,
+            "stable step: gpu {gpu_dt} cpu {cpu_dt}"
+        );
+        eprintln!(
+            "{} round {round}: regions (walls, 1-5) {count:?} agree; accelerations agree; \
+             stable step {gpu_dt:.3e} s",
+            c.name
+        );
+        held = rheology.iter().map(|r| r.held).collect();
+    }
+    // Every sediment region this test exists for occurs; Drucker-Prager both releases held
+    // sediment and keeps some held.
     let wanted: &[usize] = if model.shields_only {
         &[1, 3]
     } else {
@@ -448,6 +472,12 @@ fn check_rheology(c: Case, seed: u64) {
     };
     for &r in wanted {
         assert!(count[r] > 0, "no particle in region {r}: {count:?}");
+    }
+    eprintln!("{released} held particles released by their neighbours' stress");
+    if model.shields_only {
+        assert_eq!(released, 0, "the Shields-only mode released held sediment");
+    } else {
+        assert!(released > 0, "no held particle was released");
     }
 }
 

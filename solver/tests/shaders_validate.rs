@@ -126,6 +126,26 @@ fn texel_row_shift_is_the_same_in_rust_and_wgsl() {
     }
 }
 
+#[test]
+fn flow_onset_is_the_same_in_rust_and_wgsl() {
+    let release = ALL
+        .iter()
+        .find(|s| s.name == "yield_release")
+        .expect("release stage");
+    let module = parse("yield_release", &release.source());
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some("FLOW_ONSET"))
+        .expect("WGSL constant FLOW_ONSET");
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::F32(v)) => {
+            assert_eq!(v, flume_solver::physics::sediment::hold::FLOW_ONSET)
+        }
+        ref other => panic!("FLOW_ONSET is not an f32 literal: {other:?}"),
+    }
+}
+
 /// Offsets and size of a named WGSL struct as naga lays it out.
 fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
     let ty = module

@@ -1,5 +1,6 @@
-//! The PNG a run ends with: the final bed interfaces (Zb, Zs) along the flume against the
-//! initial bed surface, so a researcher sees the scour at a glance.
+//! The PNG a run ends with: the bed interfaces of Zubeldia et al. (2018) Section 3.3 (Zb, Zs,
+//! Zw) along the flume at a few times, one panel each, against the initial bed surface, as the
+//! paper's Figs. 13-16 show them; a researcher sees the scour at a glance.
 
 use anyhow::{Context, Result, anyhow};
 use flume_solver::ProfileColumn;
@@ -60,26 +61,48 @@ fn zs(c: &ProfileColumn) -> Option<f64> {
     c.bed.and_then(|b| b.zs_m)
 }
 
-/// Draws `path` (PNG, 1200 x 500): Zs at the start, and Zs and Zb at `t_s`, against x.
-pub fn draw(
-    path: &Path,
-    case_name: &str,
-    initial: &[ProfileColumn],
-    last: &[ProfileColumn],
-    t_s: f64,
-) -> Result<()> {
-    let lines = [
+fn zw(c: &ProfileColumn) -> Option<f64> {
+    c.bed.and_then(|b| b.zw_m)
+}
+
+/// Pixel height of one panel.
+const PANEL_HEIGHT: u32 = 260;
+
+type Line = (&'static str, Vec<Vec<(f64, f64)>>, RGBColor);
+
+/// The lines of the panel of one profile.
+fn panel_lines(initial: &[ProfileColumn], now: &[ProfileColumn]) -> Vec<Line> {
+    vec![
         (
             "initial bed surface (Zs, t = 0)",
             segments(initial, zs),
             RGBColor(150, 150, 150),
         ),
-        ("bed surface Zs", segments(last, zs), RGBColor(170, 110, 40)),
-        ("immobile bed Zb", segments(last, zb), RGBColor(120, 30, 30)),
-    ];
+        ("free surface Zw", segments(now, zw), RGBColor(40, 90, 200)),
+        ("bed surface Zs", segments(now, zs), RGBColor(200, 130, 40)),
+        ("immobile bed Zb", segments(now, zb), RGBColor(120, 30, 30)),
+    ]
+}
+
+/// Draws `path` (PNG, 1200 wide, one panel of `PANEL_HEIGHT` per profile): for each
+/// `(t, profile)` of `profiles` Zw, Zs and Zb at t against the initial bed surface, all panels
+/// on the same axes.
+pub fn draw(
+    path: &Path,
+    case_name: &str,
+    initial: &[ProfileColumn],
+    profiles: &[(f64, Vec<ProfileColumn>)],
+) -> Result<()> {
+    if profiles.is_empty() {
+        return Err(anyhow!("a bed plot needs at least one profile"));
+    }
+    let panels: Vec<(f64, Vec<Line>)> = profiles
+        .iter()
+        .map(|(t, p)| (*t, panel_lines(initial, p)))
+        .collect();
     let (mut z_lo, mut z_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (_, segs, _) in &lines {
-        for &(_, z) in segs.iter().flatten() {
+    for (_, lines) in &panels {
+        for &(_, z) in lines.iter().flat_map(|l| l.1.iter().flatten()) {
             z_lo = z_lo.min(z);
             z_hi = z_hi.max(z);
         }
@@ -91,51 +114,52 @@ pub fn draw(
     if !z_lo.is_finite() {
         return Err(anyhow!("no column holds sediment: nothing to plot"));
     }
-    let margin = (0.15 * (z_hi - z_lo)).max(0.01);
-    let (y_lo, y_hi) = (z_lo - margin, z_hi + margin);
+    let margin = (0.1 * (z_hi - z_lo)).max(0.005);
+    let y = (z_lo - margin)..(z_hi + margin);
     let text = font_registered();
     let drawn = (|| -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-        let root = BitMapBackend::new(path, (1200, 500)).into_drawing_area();
+        let height = PANEL_HEIGHT * panels.len() as u32;
+        let root = BitMapBackend::new(path, (1200, height)).into_drawing_area();
         root.fill(&WHITE)?;
-        let mut builder = ChartBuilder::on(&root);
-        builder.margin(15);
-        if text {
-            builder
-                .caption(
-                    format!("{case_name}: bed at t = {t_s:.2} s against the initial bed"),
-                    ("sans-serif", 22),
-                )
-                .x_label_area_size(45)
-                .y_label_area_size(70);
-        }
-        let mut chart = builder.build_cartesian_2d(x_lo..x_hi, y_lo..y_hi)?;
-        let mut mesh = chart.configure_mesh();
-        mesh.light_line_style(RGBColor(238, 238, 238));
-        if text {
-            mesh.x_desc("x (m)").y_desc("elevation (m)");
-        } else {
-            mesh.disable_x_axis().disable_y_axis();
-        }
-        mesh.draw()?;
-        for (label, segs, colour) in lines {
-            let mut first = true;
-            for seg in segs {
-                let series = chart.draw_series(LineSeries::new(seg, colour.stroke_width(2)))?;
-                if text && first {
-                    series.label(label).legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                    });
-                }
-                first = false;
+        let areas = root.split_evenly((panels.len(), 1));
+        for (area, (t, lines)) in areas.iter().zip(panels) {
+            let mut builder = ChartBuilder::on(area);
+            builder.margin(10);
+            if text {
+                builder
+                    .caption(format!("{case_name}, t = {t:.2} s"), ("sans-serif", 18))
+                    .x_label_area_size(35)
+                    .y_label_area_size(70);
             }
-        }
-        if text {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerLeft)
-                .draw()?;
+            let mut chart = builder.build_cartesian_2d(x_lo..x_hi, y.clone())?;
+            let mut mesh = chart.configure_mesh();
+            mesh.light_line_style(RGBColor(238, 238, 238));
+            if text {
+                mesh.x_desc("x (m)").y_desc("elevation (m)");
+            } else {
+                mesh.disable_x_axis().disable_y_axis();
+            }
+            mesh.draw()?;
+            for (label, segs, colour) in lines {
+                let mut first = true;
+                for seg in segs {
+                    let series = chart.draw_series(LineSeries::new(seg, colour.stroke_width(2)))?;
+                    if text && first {
+                        series.label(label).legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                        });
+                    }
+                    first = false;
+                }
+            }
+            if text {
+                chart
+                    .configure_series_labels()
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .position(SeriesLabelPosition::LowerLeft)
+                    .draw()?;
+            }
         }
         root.present()?;
         Ok(())
@@ -188,7 +212,13 @@ mod tests {
         let last: Vec<_> = (0..20)
             .map(|k| column(0.1 * k as f64, Some(0.05 - 0.001 * k as f64)))
             .collect();
-        draw(&path, "test", &initial, &last, 1.0).expect("draws");
+        draw(
+            &path,
+            "test",
+            &initial,
+            &[(0.5, initial.clone()), (1.0, last)],
+        )
+        .expect("draws");
         let bytes = std::fs::read(&path).expect("written");
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
         // IHDR: width and height, big-endian, after the signature, length and tag.
@@ -198,7 +228,7 @@ mod tests {
         );
         assert_eq!(
             u32::from_be_bytes(bytes[20..24].try_into().expect("4")),
-            500
+            2 * PANEL_HEIGHT
         );
         std::fs::remove_dir_all(&dir).ok();
     }
@@ -206,10 +236,13 @@ mod tests {
     #[test]
     fn a_profile_without_sediment_is_refused() {
         let cols: Vec<_> = (0..3).map(|k| column(k as f64, None)).collect();
-        let err = draw(Path::new("unused.png"), "t", &cols, &cols, 0.0).expect_err("no bed");
+        let profiles = [(0.0, cols.clone())];
+        let err = draw(Path::new("unused.png"), "t", &cols, &profiles).expect_err("no bed");
         assert!(
             err.to_string().contains("no column holds sediment"),
             "{err}"
         );
+        let err = draw(Path::new("unused.png"), "t", &cols, &[]).expect_err("no profile");
+        assert!(err.to_string().contains("at least one profile"), "{err}");
     }
 }

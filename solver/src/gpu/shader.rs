@@ -31,6 +31,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "stages/reorder.wgsl",
     "stages/forces_wcsph.wgsl",
     "stages/rheology.wgsl",
+    "stages/yield_release.wgsl",
     "stages/dt_update.wgsl",
     "stages/symplectic_predictor.wgsl",
     "stages/symplectic_corrector.wgsl",

@@ -9,13 +9,16 @@
 //! - [`shields`]: critical Shields parameter, log-law friction velocity, bed shear stress, slope
 //!   factors and surface detection (Eqs. 16-26);
 //! - [`suspension`]: volumetric concentration, Vand viscosity and the region classification of
-//!   Figure 2 (Eqs. 32-33).
+//!   Figure 2 (Eqs. 32-33);
+//! - [`pass`]: all of it for every particle, and [`hold`]: un-yielded sediment held at rest
+//!   until Drucker-Prager releases it.
 //!
 //! Like the rest of [`crate::physics`], these are plain f32 functions over scalars and slices: the
 //! oracle the GPU stages are tested against. Equation numbers are the paper's, as restored in
 //! `shared/MODEL.md`.
 
 pub mod drucker_prager;
+pub mod hold;
 pub mod pass;
 pub mod rheology;
 pub mod shields;

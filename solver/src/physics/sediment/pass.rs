@@ -8,7 +8,8 @@
 //! - the skeleton pressure of Drucker-Prager ([`skeleton_pressure`]);
 //! - what the Shields-only mode does with a sediment particle that is neither eroded nor inside
 //!   the bed ([`classify_shields_only`]);
-//! - the cap on the apparent viscosity ([`SedimentModel::mu_max`]);
+//! - the cap on the apparent viscosity ([`SedimentModel::mu_max`]), and the hold of
+//!   un-yielded sediment that makes up for it ([`super::hold`]);
 //! - the bed slope, from the normal of the sediment-water interface ([`slope_factors`]).
 
 use super::SedimentParams;
@@ -34,11 +35,13 @@ pub struct SedimentModel {
     pub sediment_phase: usize,
     pub water_phase: usize,
     /// The paper's Shields-only mode: sediment that is neither eroded nor suspended is held
-    /// fixed, and Drucker-Prager is not used.
+    /// fixed, and Drucker-Prager is not used. Otherwise un-yielded sediment is held until
+    /// Drucker-Prager releases it ([`super::hold`]).
     pub shields_only: bool,
-    /// Largest apparent viscosity, Pa s. An explicit scheme is stable for
-    /// `dt <= 0.125 h^2 rho / mu`; the un-yielded HBP viscosity (tau_y m, tens of thousands of
-    /// Pa s for the Louvain bed) would need steps 10^4 times shorter than the acoustic ones.
+    /// Largest apparent viscosity, Pa s, of the stress a particle carries. An explicit scheme
+    /// is stable for `dt <= 0.125 h^2 rho / mu`; the un-yielded HBP viscosity (tau_y m, tens of
+    /// thousands of Pa s for the Louvain bed) would need steps 10^2 to 10^3 times shorter than
+    /// the acoustic ones.
     pub mu_max: f32,
 }
 
@@ -51,7 +54,7 @@ pub struct ParticleRheology {
     pub mu: f32,
     /// Region 1-5 of Figure 2 (5 for water), 0 for walls.
     pub region: u32,
-    /// Held fixed this step (Shields-only mode, sediment neither eroded nor suspended).
+    /// Held fixed this step: un-yielded sediment (region 1).
     pub held: bool,
 }
 
@@ -130,7 +133,10 @@ fn norm3(a: [f32; 3]) -> f32 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
-/// The rheology of every particle (see the module doc).
+/// The rheology of every particle (see the module doc), `held_before[i]` whether particle i was
+/// held after the previous pass. In the Drucker-Prager mode a particle held before stays held
+/// unless Shields makes it bed load: only [`super::hold::release_pass`], which follows this
+/// pass, releases it by the stress of its neighbours.
 ///
 /// Panics if the slices differ in length or a phase index is outside `params.phases` (bugs of
 /// the caller).
@@ -139,8 +145,10 @@ pub fn rheology_pass(
     model: &SedimentModel,
     pos: &[[f32; 4]],
     vel_rho: &[[f32; 4]],
+    held_before: &[bool],
 ) -> Vec<ParticleRheology> {
     assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
+    assert_eq!(pos.len(), held_before.len(), "positions and holds differ");
     let h = params.h;
     let dim = params.dim;
     let support2 = 4.0 * h * h;
@@ -236,19 +244,26 @@ pub fn rheology_pass(
                 let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
                 let region = if model.shields_only {
                     classify_shields_only(at_surface, tau_b, tau_bcr, c_v)
+                } else if held_before[i] && !(at_surface && tau_b > tau_bcr) {
+                    Region::Unyielded
                 } else {
                     let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
                     let sqrt_j2 = 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt();
                     classify(true, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v)
                 };
                 let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
-                let held = model.shields_only && region == Region::Unyielded;
-                (region as u32, mu.min(model.mu_max), held)
+                (
+                    region as u32,
+                    mu.min(model.mu_max),
+                    region == Region::Unyielded,
+                )
             } else {
                 (Region::Water as u32, phase_i.mu, false)
             };
             let mut stress = [[0.0_f32; 3]; 3];
-            if !held {
+            // Shields-only holds carry no stress, as that mode always had; Drucker-Prager holds
+            // keep theirs (`super::hold`).
+            if !(held && model.shields_only) {
                 for a in 0..3 {
                     for b in 0..3 {
                         stress[a][b] = 2.0 * mu * eps[a][b];

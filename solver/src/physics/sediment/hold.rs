@@ -1,0 +1,167 @@
+//! Un-yielded sediment held at rest, and released by the stress its moving neighbours transmit
+//! (the Drucker-Prager mode's answer to the creep of a capped viscosity).
+//!
+//! The paper keeps region 1 static through its HBP viscosity `tau_y m`, tens of thousands of
+//! Pa s for the Louvain bed. An explicit scheme is stable only for `dt <= 0.125 h^2 rho / mu`:
+//! at dp = 5 mm that is about 1e-6 s against the acoustic 1e-4 s, a hundred times the steps.
+//! Capping the viscosity (`SedimentModel::mu_max`) keeps the step and turns the bed into a
+//! liquid of tens of Pa s that a dam-break wave shears down to the floor, the "excessive
+//! creeping resulting from a fluid model" of the paper's Fig. 12. So, as Manenti et al. (2012)
+//! and the paper's own Shields-only mode do, un-yielded sediment is held fixed; unlike them the
+//! hold is released where Drucker-Prager says the particle yields.
+//!
+//! The test needs the particle's shear stress. A held particle has no strain rate of its own
+//! that measures it: at rest between moving neighbours its strain rate is theirs, at rest
+//! among held ones it is zero whatever the load. Its stress is what the sediment moving next
+//! to it carries, continuous across the interface as momentum balance requires. So:
+//! - a sediment particle that moves is classified by the stress it carries (Eq. 30 on
+//!   `2 mu eps` with the capped viscosity, as before the hold), and held when that says it is
+//!   un-yielded;
+//! - a held particle stays held unless Shields makes it bed load (Eq. 25) or the stress
+//!   transmitted by its moving sediment neighbours (their Shepard average,
+//!   `sum_j V_j W_ij tau_j / sum_j V_j W_ij`) exceeds the stress at which its own HBP law
+//!   flows, [`FLOW_ONSET`] times its yield stress (Eqs. 15, 30-31). The yield stress grows with
+//!   the skeleton pressure, so the release stops at the depth where the transmitted stress
+//!   falls below it: the boundary between regions 1 and 2 comes from Eq. 31, not from a fixed
+//!   depth.
+//!
+//! Why twice the yield stress and not Eq. 30's `sqrt(J2) > tau_y`: Eq. 15 as written
+//! (`tau = 2 mu eps`) makes a flowing particle carry `sqrt(J2) = 2 tau_y (1 - exp(-m s)) + ...`,
+//! at least 2 tau_y once `m s >> 1` (the `rheology` module doc). In the paper's uncapped model
+//! a particle loaded between tau_y and 2 tau_y is "yielded" but creeps at `s < ~3 / m`,
+//! 0.03 1/s for the Louvain bed: it stays where it is. Released at tau_y instead, a particle
+//! flows and transmits 2 tau_y of its own to the one below, whose yield stress is larger by
+//! only a factor `1 + dp / depth`: the release runs down to the floor whatever the load (seen
+//! on the Louvain case at dp = 5 mm: the bottom row at the gate slid 54 mm by t = 0.25 s).
+//! Once moving, a particle is held again when the stress it carries falls below tau_y itself:
+//! it takes twice the stress to start the bed as to keep it going, static friction above
+//! dynamic, as in a granular bed.
+//!
+//! Held particles keep their viscous stress `2 mu eps` in the force pass: a moving neighbour is
+//! dragged by them as by the slow bed of the unheld model. The GPU's
+//! `shaders/stages/yield_release.wgsl` must give the same regions.
+
+use super::drucker_prager::{alpha, kappa_c, yield_stress, yields};
+use super::pass::{ParticleRheology, SedimentModel, skeleton_pressure};
+use super::rheology::{Tensor3, second_invariant};
+use super::suspension::Region;
+use crate::physics::Params;
+use crate::physics::eos::{pressure, tait_b};
+use crate::physics::interaction::phase_index;
+use crate::physics::kernel::w;
+
+/// Shepard average `sum_j weight_j tau_j / sum_j weight_j` of the stresses of the moving
+/// neighbours, Pa; `None` when no weight is positive (nothing moves next to the particle).
+pub fn transmitted_stress(weights: &[f32], stresses: &[Tensor3]) -> Option<Tensor3> {
+    assert_eq!(weights.len(), stresses.len(), "weights and stresses differ");
+    let total: f32 = weights.iter().sum();
+    if total.is_nan() || total <= 0.0 {
+        return None;
+    }
+    let mut tau = [[0.0_f32; 3]; 3];
+    for (&wj, t) in weights.iter().zip(stresses) {
+        for a in 0..3 {
+            for b in 0..3 {
+                tau[a][b] += wj * t[a][b];
+            }
+        }
+    }
+    for row in &mut tau {
+        for x in row {
+            *x /= total;
+        }
+    }
+    Some(tau)
+}
+
+/// The stress invariant at which Eq. 15 (as written) lets sediment of yield stress tau_y flow,
+/// in units of tau_y: `sqrt(J2) = 2 mu sqrt(II_D) -> 2 tau_y` as `m sqrt(II_D)` grows.
+pub const FLOW_ONSET: f32 = 2.0;
+
+/// Whether a held particle of yield stress `tau_y` (Pa) is released by the transmitted stress
+/// `tau`: its invariant `sqrt(J2)` exceeds `FLOW_ONSET tau_y` (Eq. 30 with Eq. 15's onset).
+pub fn released(tau: &Tensor3, tau_y: f32) -> bool {
+    yields(second_invariant(tau).sqrt(), FLOW_ONSET * tau_y)
+}
+
+/// Releases the held sediment that its moving neighbours make yield (see the module doc), in
+/// place: a released particle becomes region 2 and not held. Which neighbours move is read from
+/// `rheology` as the rheology pass left it, before any release, so the result does not depend
+/// on the order particles are visited. Shields-only runs are left as they are.
+///
+/// Panics if the slices differ in length (a bug of the caller).
+pub fn release_pass(
+    params: &Params,
+    model: &SedimentModel,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+    rheology: &mut [ParticleRheology],
+) {
+    assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
+    assert_eq!(pos.len(), rheology.len(), "positions and rheology differ");
+    if model.shields_only {
+        return;
+    }
+    let mat = &model.material;
+    let (alpha_dp, kappa_dp) = (alpha(mat.phi_rad), kappa_c(mat.phi_rad, mat.cohesion_pa));
+    let sed = &params.phases[model.sediment_phase];
+    let b = tait_b(params.c0, sed.rho0);
+    let support2 = 4.0 * params.h * params.h;
+    let is_sediment = |k: usize| phase_index(&pos[k]) == model.sediment_phase;
+    let release: Vec<usize> = (0..pos.len())
+        .filter(|&i| rheology[i].held && is_sediment(i))
+        .filter(|&i| {
+            let (mut weights, mut stresses) = (Vec::new(), Vec::new());
+            for j in (0..pos.len()).filter(|&j| j != i && is_sediment(j) && !rheology[j].held) {
+                let r2: f32 = (0..3).map(|k| (pos[i][k] - pos[j][k]).powi(2)).sum();
+                if r2 < support2 {
+                    let v_j = sed.mass / vel_rho[j][3];
+                    weights.push(v_j * w(r2.sqrt(), params.h, params.dim));
+                    stresses.push(rheology[j].stress);
+                }
+            }
+            let p = pressure(vel_rho[i][3], sed.rho0, b);
+            let tau_y = yield_stress(
+                alpha_dp,
+                kappa_dp,
+                skeleton_pressure(p, mat.rho_s, mat.rho_w),
+            );
+            transmitted_stress(&weights, &stresses).is_some_and(|t| released(&t, tau_y))
+        })
+        .collect();
+    for i in release {
+        rheology[i].held = false;
+        rheology[i].region = Region::Yielded as u32;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shear(t: f32) -> Tensor3 {
+        [[0.0, t, 0.0], [t, 0.0, 0.0], [0.0, 0.0, 0.0]]
+    }
+
+    #[test]
+    fn transmitted_stress_is_the_weighted_mean() {
+        // Weights 1 and 3 on shear stresses 10 and 30 Pa: (10 + 90) / 4 = 25 Pa.
+        let t = transmitted_stress(&[1.0, 3.0], &[shear(10.0), shear(30.0)]).expect("weights");
+        assert_eq!(t[0][1], 25.0);
+        assert_eq!(t[1][0], 25.0);
+        assert_eq!(t[0][0], 0.0);
+        assert!(transmitted_stress(&[], &[]).is_none());
+        assert!(transmitted_stress(&[0.0], &[shear(1.0)]).is_none());
+    }
+
+    #[test]
+    fn released_above_the_yield_stress_only() {
+        // Simple shear t: J2 = 1/2 (t^2 + t^2) = t^2, so sqrt(J2) = t; the onset is 2 tau_y.
+        assert!(released(&shear(20.5), 10.0));
+        assert!(!released(&shear(20.0), 10.0));
+        assert!(!released(&shear(15.0), 10.0));
+        assert!(!released(&shear(-19.0), 10.0));
+        // Cohesionless sand at zero skeleton pressure gives way to any shear.
+        assert!(released(&shear(1e-6), 0.0));
+    }
+}
