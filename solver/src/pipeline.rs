@@ -142,6 +142,8 @@ pub struct GpuBuffers {
     pub stress_a: wgpu::TextureView,
     pub stress_b: wgpu::TextureView,
     pub regions: wgpu::Buffer,
+    /// A copy of `regions` taken with `snapshot`: which sediment is held is state too.
+    pub regions_snapshot: wgpu::Buffer,
     pub forces: wgpu::Buffer,
     pub cell_of: wgpu::Buffer,
     pub cell_starts: wgpu::Buffer,
@@ -255,6 +257,7 @@ impl GpuBuffers {
             stress_a: particle_texture(gpu, "stress_a", n, TEXEL_ROW_SHIFT),
             stress_b: particle_texture(gpu, "stress_b", n, TEXEL_ROW_SHIFT),
             regions: storage(gpu, "regions", n * 4),
+            regions_snapshot: storage(gpu, "regions snapshot", n * 4),
             forces: storage(gpu, "forces", n * VEC4_BYTES),
             cell_of: storage(gpu, "cell_of", n * 4),
             cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),

@@ -315,6 +315,7 @@ impl Simulation {
         let saved = (self.time_s, self.steps, self.last_dt_s, self.dt_taken);
         let saved_flume = self.flume.clone();
         self.copy_state(&self.buffers.a, &self.buffers.snapshot);
+        self.copy_holds(&self.buffers.regions, &self.buffers.regions_snapshot);
         let mut tries = 0;
         // When the first try failed, and whether every retry failed at about the same time:
         // an unstable step fails after about as many steps whatever their length, so halving
@@ -356,6 +357,7 @@ impl Simulation {
             tries += 1;
             self.clean_chunks = 0;
             self.copy_state(&self.buffers.snapshot, &self.buffers.a);
+            self.copy_holds(&self.buffers.regions_snapshot, &self.buffers.regions);
             (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
             self.flume.clone_from(&saved_flume);
             self.params.cfl *= 0.5;
@@ -419,6 +421,14 @@ impl Simulation {
             .queue
             .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
         Ok(())
+    }
+
+    /// Copies the region words (with the holds of the Drucker-Prager mode, which the next
+    /// rheology pass starts from).
+    fn copy_holds(&self, from: &wgpu::Buffer, to: &wgpu::Buffer) {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(from, 0, to, 0, from.size());
+        self.gpu.queue.submit([encoder.finish()]);
     }
 
     fn copy_state(&self, from: &StateBuffers, to: &StateBuffers) {
