@@ -106,44 +106,38 @@ fn entry_points_and_workgroup_sizes_match() {
     }
 }
 
-#[test]
-fn texel_row_shift_is_the_same_in_rust_and_wgsl() {
-    let forces = ALL
+/// The literal a WGSL constant of `stage`'s composed module is initialised with.
+fn wgsl_constant(stage: &str, name: &str) -> naga::Literal {
+    let spec = ALL
         .iter()
-        .find(|s| s.name == "forces_wcsph")
-        .expect("forces stage");
-    let module = parse("forces_wcsph", &forces.source());
+        .find(|s| s.name == stage)
+        .unwrap_or_else(|| panic!("no stage {stage}"));
+    let module = parse(stage, &spec.source());
     let (_, c) = module
         .constants
         .iter()
-        .find(|(_, c)| c.name.as_deref() == Some("TEXEL_ROW_SHIFT"))
-        .expect("WGSL constant TEXEL_ROW_SHIFT");
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no WGSL constant {name} in {stage}"));
     match module.global_expressions[c.init] {
-        naga::Expression::Literal(naga::Literal::U32(v)) => {
-            assert_eq!(v, flume_solver::pipeline::TEXEL_ROW_SHIFT)
-        }
-        ref other => panic!("TEXEL_ROW_SHIFT is not a u32 literal: {other:?}"),
+        naga::Expression::Literal(v) => v,
+        ref other => panic!("{name} is not a literal: {other:?}"),
     }
 }
 
 #[test]
+fn texel_row_shift_is_the_same_in_rust_and_wgsl() {
+    assert_eq!(
+        wgsl_constant("forces_wcsph", "TEXEL_ROW_SHIFT"),
+        naga::Literal::U32(flume_solver::pipeline::TEXEL_ROW_SHIFT)
+    );
+}
+
+#[test]
 fn flow_onset_is_the_same_in_rust_and_wgsl() {
-    let release = ALL
-        .iter()
-        .find(|s| s.name == "yield_release")
-        .expect("release stage");
-    let module = parse("yield_release", &release.source());
-    let (_, c) = module
-        .constants
-        .iter()
-        .find(|(_, c)| c.name.as_deref() == Some("FLOW_ONSET"))
-        .expect("WGSL constant FLOW_ONSET");
-    match module.global_expressions[c.init] {
-        naga::Expression::Literal(naga::Literal::F32(v)) => {
-            assert_eq!(v, flume_solver::physics::sediment::hold::FLOW_ONSET)
-        }
-        ref other => panic!("FLOW_ONSET is not an f32 literal: {other:?}"),
-    }
+    assert_eq!(
+        wgsl_constant("yield_release", "FLOW_ONSET"),
+        naga::Literal::F32(flume_solver::physics::sediment::hold::FLOW_ONSET)
+    );
 }
 
 /// Offsets and size of a named WGSL struct as naga lays it out.

@@ -96,6 +96,9 @@ pub fn draw(
     if profiles.is_empty() {
         return Err(anyhow!("a bed plot needs at least one profile"));
     }
+    if !profiles.iter().any(|(_, p)| p.iter().any(|c| zs(c).is_some())) {
+        return Err(anyhow!("no column holds sediment: nothing to plot"));
+    }
     let panels: Vec<(f64, Vec<Line>)> = profiles
         .iter()
         .map(|(t, p)| (*t, panel_lines(initial, p)))
@@ -111,9 +114,6 @@ pub fn draw(
         (Some(a), Some(b)) if b.x_m > a.x_m => (a.x_m, b.x_m),
         _ => return Err(anyhow!("a bed plot needs at least two profile columns")),
     };
-    if !z_lo.is_finite() {
-        return Err(anyhow!("no column holds sediment: nothing to plot"));
-    }
     let margin = (0.1 * (z_hi - z_lo)).max(0.005);
     let y = (z_lo - margin)..(z_hi + margin);
     let text = font_registered();
