@@ -61,7 +61,9 @@ fn out_of_range(rho: f32, rho0: f32) -> bool {
 
 // Writes particle i's (id `id`) new position x, velocity v and density rho (p, vr: its old
 // state). Walls (DBC) keep their position and velocity, and their density never drops below
-// rho0 so that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest.
+// rho0 so that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest,
+// and without tension (clamp_pressure) its density stays at or above rest as a free particle's
+// does: a held bed under sand sliding off it would otherwise thin out without end.
 // In an open flume: parked particles stay parked; fluid past the outlet and sediment in the
 // collector are parked; the inlet buffer moves at the inlet velocity, at its density; water in
 // a bottom outlet's duct moves at the valve's velocity; a free particle whose density leaves
@@ -101,9 +103,10 @@ fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: ve
         }
     }
     if (ph.mobile > 0.5 && is_held(id)) {
+        let r = select(rho, max(rho, ph.rho0), params.clamp_pressure != 0u);
         positions_out[i] = p;
-        vel_rho_out[i] = vec4<f32>(0.0, 0.0, 0.0, rho);
-        check_health(p.xyz, vec3<f32>(0.0), rho, ph.rho0);
+        vel_rho_out[i] = vec4<f32>(0.0, 0.0, 0.0, r);
+        check_health(p.xyz, vec3<f32>(0.0), r, ph.rho0);
     } else if (ph.mobile > 0.5) {
         // Without tension (the case's clamp_negative_pressure) the density never falls below
         // rest: a sheet too thin for a full kernel would otherwise thin out without end.

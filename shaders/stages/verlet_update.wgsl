@@ -5,7 +5,8 @@
 // every `euler_every` steps (and the first) an Euler step v(n+1) = v(n) + dt a(n),
 // rho(n+1) = rho(n) + dt drho(n) brings the two interleaved sequences back together.
 // Walls (DBC) keep position and velocity and never drop below rho0. Writes the new state,
-// in cell order, to the state buffers and the current one to `vel_rho_prev`.
+// in cell order, to the state buffers and the current one to `vel_rho_prev` (at rest for held
+// sediment).
 // Reference: solver/src/physics/integrate.rs.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
@@ -42,7 +43,10 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let rho = base.w + span * f.w;
     ids_out[i] = ids_n[i];
-    vel_rho_prev_out[i] = vr;
+    // Held sediment is at rest in both interleaved sequences: a particle held at n and
+    // released at n + 1 must not take back the velocity it had at n - 1.
+    let held = ph.mobile > 0.5 && is_held(ids_n[i]);
+    vel_rho_prev_out[i] = select(vr, vec4<f32>(0.0, 0.0, 0.0, vr.w), held);
     let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
     store_state(i, ids_n[i], p, vr, x, base.xyz + span * f.xyz, rho, ph);
 }

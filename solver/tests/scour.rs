@@ -211,9 +211,9 @@ fn ulbra_erosion_grows_with_bed_roughness() {
 /// gate slid 54 mm by 0.25 s, up to 16 dp of moving sand in a column).
 /// - The moving layer (regions 2-4), as the depth the sand it holds would fill across a 5 cm
 ///   column, averaged over the columns where sand moves: a transport layer of a few grains,
-///   at most 5 dp = 7 d50 (measured 2.3-4.1 dp).
+///   at most 5 dp = 7 d50 (measured 2.3-4.1 dp over the four times in three runs).
 /// - The same in the worst column: the surge front carries a cloud of sand mixed into the
-///   water, so the bound is the weaker 10 dp, below the bed's depth (measured 7.3-8.8 dp).
+///   water, so the bound is the weaker 10 dp, below the bed's depth (measured 6.0-8.8 dp).
 const MEAN_LAYER_DP: f64 = 5.0;
 const MAX_LAYER_DP: f64 = 10.0;
 

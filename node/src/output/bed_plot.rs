@@ -96,7 +96,10 @@ pub fn draw(
     if profiles.is_empty() {
         return Err(anyhow!("a bed plot needs at least one profile"));
     }
-    if !profiles.iter().any(|(_, p)| p.iter().any(|c| zs(c).is_some())) {
+    if !profiles
+        .iter()
+        .any(|(_, p)| p.iter().any(|c| zs(c).is_some()))
+    {
         return Err(anyhow!("no column holds sediment: nothing to plot"));
     }
     let panels: Vec<(f64, Vec<Line>)> = profiles
