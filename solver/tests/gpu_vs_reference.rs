@@ -364,6 +364,97 @@ fn probe_interpolate_phase_fullness_matches_the_cpu() {
     }
 }
 
+/// A sediment case started from its perturbed lattice (random velocities up to 0.3 m/s: strain
+/// rates of tens per second, bed shear stresses on both sides of the Shields threshold, yielded
+/// and un-yielded sediment) with the lower three quarters of the bed at rest, so that the
+/// first rheology pass holds them and the release stage has held sand under moving sand to
+/// decide on.
+fn sediment_in_motion(
+    gpu: &std::sync::Arc<flume_solver::GpuContext>,
+    c: &Case,
+    seed: u64,
+) -> (
+    flume_solver::Simulation,
+    flume_solver::case::Particles,
+    flume_solver::physics::Params,
+) {
+    let lattice = flume_solver::Simulation::new(std::sync::Arc::clone(gpu), c).expect("builds");
+    let mut particles = common::perturbed(&lattice, 0.3, seed);
+    let at_rest_below = 0.75 * c.fluid_blocks[0].max_m[1] as f32;
+    for i in 0..particles.len() {
+        if particles.phase(i) == 2 && particles.positions[i][1] < at_rest_below {
+            particles.vel_rho[i][..3].fill(0.0);
+        }
+    }
+    let sim =
+        flume_solver::Simulation::from_particles(std::sync::Arc::clone(gpu), c, particles.clone())
+            .expect("builds");
+    let params = common::reference_params(&sim);
+    (sim, particles, params)
+}
+
+/// Two Verlet steps of a sand bed in motion against the CPU: the forces with the rheology and
+/// release passes, then `integrate::verlet` with the holds of `integrate::hold_at_rest`; the
+/// second step starts from the first one's holds and from its `vel_rho_prev`, so a grain held
+/// for the first step and released in the second is checked too (when there is one).
+#[test]
+fn two_verlet_steps_with_held_sand_match_the_cpu_steps() {
+    use flume_solver::physics::sediment::{hold, pass};
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let c = case("tests/cases/sediment_bed_2d.yaml");
+    let (mut sim, particles, params) = sediment_in_motion(&gpu, &c, 23);
+    let model = common::reference_sediment(&sim);
+    let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
+    sim.advance_to(f64::from(dt)).expect("step 1");
+    sim.advance_to(f64::from(dt) + f64::from(dt2))
+        .expect("step 2");
+    assert_eq!(sim.steps(), 2);
+    let after = sim.read_particles().expect("readback");
+
+    let n = particles.len();
+    let forces = |pos: &[[f32; 4]], vel: &[[f32; 4]], held_before: &[bool]| {
+        let mut r = pass::rheology_pass(&params, &model, pos, vel, held_before);
+        hold::release_pass(&params, &model, pos, vel, &mut r);
+        let mut f = interaction::interact(&params, pos, vel).forces;
+        for (f, s) in f
+            .iter_mut()
+            .zip(pass::stress_divergence(&params, pos, vel, &r))
+        {
+            for k in 0..3 {
+                f[k] += s[k];
+            }
+        }
+        (f, r.iter().map(|r| r.held).collect::<Vec<bool>>())
+    };
+    let (pos0, vel0) = (&particles.positions, &particles.vel_rho);
+    let clamp = params.clamp_negative_pressure;
+    let (f0, held1) = forces(pos0, vel0, &vec![false; n]);
+    let mut s1 = integrate::verlet(&params.phases, dt, 0.0, true, pos0, vel0, vel0, &f0);
+    integrate::hold_at_rest(&params.phases, clamp, pos0, vel0, &held1, &mut s1);
+    let (f1, held2) = forces(&s1.0, &s1.1, &held1);
+    let mut s2 = integrate::verlet(&params.phases, dt2, dt, false, &s1.0, &s1.1, &s1.2, &f1);
+    integrate::hold_at_rest(&params.phases, clamp, &s1.0, &s1.1, &held2, &mut s2);
+    let count = |h: &[bool]| h.iter().filter(|&&h| h).count();
+    let released = (0..n).filter(|&i| held1[i] && !held2[i]).count();
+    eprintln!(
+        "held {} then {}; {released} released in the second step",
+        count(&held1),
+        count(&held2)
+    );
+    assert!(count(&held1) > 0 && count(&held2) > 0, "nothing held");
+    assert_step_close(&after, &s2.0, &s2.1, &[&f0, &f1], dt, 2.0);
+    // Sand held in both steps is exactly where it started, at rest.
+    for i in (0..n).filter(|&i| held1[i] && held2[i]) {
+        assert_eq!(after.positions[i], pos0[i], "held particle {i} moved");
+        assert_eq!(
+            after.vel_rho[i][..3],
+            [0.0; 3],
+            "held particle {i} has a velocity"
+        );
+    }
+}
+
 /// The rheology pass, the release of held sediment and the multiphase force pass against
 /// `sediment::pass` and `sediment::hold`: regions word for word, accelerations (pressure plus
 /// stress divergence) and density rates within 1e-4 of the largest, and the stable step with
@@ -373,20 +464,7 @@ fn check_rheology(c: Case, seed: u64) {
     use flume_solver::physics::sediment::{hold, pass};
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
-    // Random velocities up to 0.3 m/s over a perturbed lattice: strain rates of tens per
-    // second, bed shear stresses on both sides of the Shields threshold, yielded and
-    // un-yielded sediment. The lower three quarters of the bed are at rest, so that the first pass holds
-    // it and the release stage has held particles under moving ones to decide on.
-    let lattice = flume_solver::Simulation::new(std::sync::Arc::clone(&gpu), &c).expect("builds");
-    let mut particles = common::perturbed(&lattice, 0.3, seed);
-    let at_rest_below = 0.75 * c.fluid_blocks[0].max_m[1] as f32;
-    for i in 0..particles.len() {
-        if particles.phase(i) == 2 && particles.positions[i][1] < at_rest_below {
-            particles.vel_rho[i][..3].fill(0.0);
-        }
-    }
-    let sim = flume_solver::Simulation::from_particles(gpu, &c, particles.clone()).expect("builds");
-    let params = common::reference_params(&sim);
+    let (sim, particles, params) = sediment_in_motion(&gpu, &c, seed);
     let model = common::reference_sediment(&sim);
     let (pos, vel) = (&particles.positions, &particles.vel_rho);
     let mut held = vec![false; particles.len()];

@@ -155,6 +155,31 @@ pub fn verlet(
     (pos_new, vel_new, vel_rho.to_vec())
 }
 
+/// Applies the holds of the sediment model to a Verlet step taken by [`verlet`] from `pos`,
+/// `vel_rho` at n: a held mobile particle keeps its position at rest in both of the leapfrog's
+/// sequences (its `vel_rho_prev` at n is at rest too, so that released at n + 1 it does not
+/// take back the velocity of n - 1), and with `clamp` (no tension) its density stays at or
+/// above rho0, as `store_state.wgsl` does.
+///
+/// Panics if the slices differ in length (caller bugs).
+pub fn hold_at_rest(
+    phases: &[Phase],
+    clamp: bool,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+    held: &[bool],
+    step: &mut VerletState,
+) {
+    assert!(pos.len() == vel_rho.len() && pos.len() == held.len() && pos.len() == step.0.len());
+    for i in (0..pos.len()).filter(|&i| held[i] && phases[phase_index(&pos[i])].mobile) {
+        let rho0 = phases[phase_index(&pos[i])].rho0;
+        let rho = step.1[i][3];
+        step.0[i] = pos[i];
+        step.1[i] = [0.0, 0.0, 0.0, if clamp { rho.max(rho0) } else { rho }];
+        step.2[i] = [0.0, 0.0, 0.0, vel_rho[i][3]];
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::interaction::interact;
