@@ -233,6 +233,81 @@ fn moving_layers(p: &Particles, regions: &[u32], dp: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Zb is never above Zs, and ahead of the water front (x beyond `front`) the bed surface is
+/// within dp of its initial level `zs0`.
+fn assert_bed_holds_ahead(
+    obs: &flume_solver::Observations,
+    zs0: &[f64],
+    front: f64,
+    dp: f64,
+    t: f64,
+) {
+    for (col, zs0) in obs.profile.iter().zip(zs0) {
+        let b = col.bed.expect("interfaces");
+        let zs = b.zs_m.expect("sand under every column");
+        if let Some(zb) = b.zb_m {
+            assert!(
+                zb <= zs + 0.5 * dp,
+                "x = {}: Zb {zb} above Zs {zs}",
+                col.x_m
+            );
+        }
+        if col.x_m > front {
+            assert!(
+                (zs - zs0).abs() <= dp,
+                "t = {t} s, x = {} m ahead of the front at {front:.3} m: Zs {zs0} -> {zs}",
+                col.x_m
+            );
+        }
+    }
+}
+
+/// Some sand moves, and the moving layer keeps to `MEAN_LAYER_DP` and `MAX_LAYER_DP`.
+fn assert_moving_layer_bounded(now: &Particles, regions: &[u32], dp: f64, t: f64) {
+    let layers: Vec<f64> = moving_layers(now, regions, dp)
+        .into_iter()
+        .map(|(_, d)| d)
+        .filter(|&d| d > 0.0)
+        .collect();
+    let worst = layers.iter().copied().fold(0.0, f64::max);
+    let mean = layers.iter().sum::<f64>() / layers.len().max(1) as f64;
+    eprintln!(
+        "  moving layer {:.1} dp on average over {} columns, {:.1} dp at most",
+        mean / dp,
+        layers.len(),
+        worst / dp
+    );
+    assert!(!layers.is_empty(), "t = {t} s: no sand moves");
+    assert!(
+        mean <= MEAN_LAYER_DP * dp,
+        "t = {t} s: moving layer {mean} m on average"
+    );
+    assert!(
+        worst <= MAX_LAYER_DP * dp,
+        "t = {t} s: moving layer {worst} m in a column"
+    );
+}
+
+/// The bed surface at x = 1.0-1.3 m, below the gate, lies more than dp under its initial level
+/// somewhere.
+fn assert_scour_hole(obs: &flume_solver::Observations, zs0: &[f64], dp: f64, t: f64) {
+    let (hole, hole0) = obs
+        .profile
+        .iter()
+        .zip(zs0)
+        .filter(|(col, _)| (1.0..=1.3).contains(&col.x_m))
+        .map(|(col, &z0)| (col.bed.and_then(|b| b.zs_m).unwrap_or(0.0), z0))
+        .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a });
+    eprintln!(
+        "  bed surface 1.0-1.3 m: {:.1} mm at its lowest",
+        hole * 1e3
+    );
+    assert!(
+        hole < hole0 - dp,
+        "t = {t} s: no scour hole below the gate: Zs {hole} m against {hole0} m"
+    );
+}
+
 /// The Louvain erosional dam break (the paper's case C) at dp = 5 mm, about 10,000 particles,
 /// to t = 1 s, checked at the paper's four times (Figs. 13-16):
 /// - the un-yielded bed holds: no sand that starts within 2 dp of the floor moves dp / 2, and
@@ -290,68 +365,14 @@ fn louvain_dam_break_scours_below_the_gate_and_the_bed_holds() {
             slid < 0.5 * dp,
             "t = {t} s: a floor particle moved {slid} m"
         );
-        // Ahead of the water front the bed surface holds; Zb is never above Zs.
         let front = (0..now.len())
             .filter(|&i| now.phase(i) == WATER)
             .map(|i| f64::from(now.positions[i][0]))
             .fold(0.0, f64::max);
-        for (col, zs0) in obs.profile.iter().zip(&zs0) {
-            let b = col.bed.expect("interfaces");
-            let zs = b.zs_m.expect("sand under every column");
-            if let Some(zb) = b.zb_m {
-                assert!(
-                    zb <= zs + 0.5 * dp,
-                    "x = {}: Zb {zb} above Zs {zs}",
-                    col.x_m
-                );
-            }
-            if col.x_m > front {
-                assert!(
-                    (zs - zs0).abs() <= dp,
-                    "t = {t} s, x = {} m ahead of the front at {front:.3} m: Zs {zs0} -> {zs}",
-                    col.x_m
-                );
-            }
-        }
-        // The moving layer is bounded.
-        let layers: Vec<f64> = moving_layers(&now, &regions, dp)
-            .into_iter()
-            .map(|(_, d)| d)
-            .filter(|&d| d > 0.0)
-            .collect();
-        let worst = layers.iter().copied().fold(0.0, f64::max);
-        let mean = layers.iter().sum::<f64>() / layers.len().max(1) as f64;
-        eprintln!(
-            "  front {front:.3} m; moving layer {:.1} dp on average over {} columns, {:.1} dp at most",
-            mean / dp,
-            layers.len(),
-            worst / dp
-        );
-        assert!(!layers.is_empty(), "t = {t} s: no sand moves");
-        assert!(
-            mean <= MEAN_LAYER_DP * dp,
-            "t = {t} s: moving layer {mean} m on average"
-        );
-        assert!(
-            worst <= MAX_LAYER_DP * dp,
-            "t = {t} s: moving layer {worst} m in a column"
-        );
-        // The scour hole below the gate.
-        let (hole, hole0) = obs
-            .profile
-            .iter()
-            .zip(&zs0)
-            .filter(|(col, _)| (1.0..=1.3).contains(&col.x_m))
-            .map(|(col, &z0)| (col.bed.and_then(|b| b.zs_m).unwrap_or(0.0), z0))
-            .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a });
-        eprintln!(
-            "  bed surface 1.0-1.3 m: {:.1} mm at its lowest",
-            hole * 1e3
-        );
-        assert!(
-            hole < hole0 - dp,
-            "t = {t} s: no scour hole below the gate: Zs {hole} m against {hole0} m"
-        );
+        eprintln!("  front {front:.3} m");
+        assert_bed_holds_ahead(&obs, &zs0, front, dp, t);
+        assert_moving_layer_bounded(&now, &regions, dp, t);
+        assert_scour_hole(&obs, &zs0, dp, t);
     }
 }
 
