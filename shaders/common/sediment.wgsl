@@ -169,6 +169,14 @@ fn hbp_viscosity(ii_d: f32, tau_c: f32) -> f32 {
     return yield_term + power_term;
 }
 
+// Eqs. 29-31, the Drucker-Prager yield stress of a sediment particle of density rho, Pa, from
+// its skeleton pressure p (1 - rho_w / rho_s) (`skeleton_pressure` in pass.rs).
+fn drucker_prager_yield(rho: f32) -> f32 {
+    let sd = params.sediment;
+    let p_skel = tait_pressure(rho, sd.phase) * (1.0 - sd.rho_w / sd.rho_s);
+    return sd.dp_alpha * max(p_skel, 0.0) + sd.dp_kappa;
+}
+
 // Eq. 33, Vand's suspension viscosity, Pa s.
 fn vand_viscosity(c_v: f32) -> f32 {
     return params.sediment.mu_w * exp(2.5 * c_v / (1.0 - 39.0 / 64.0 * c_v));

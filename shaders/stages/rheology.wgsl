@@ -114,8 +114,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     var mu = ph_i.mu;
     var region = REGION_WATER;
     if (is_sediment) {
-        let p_skel = tait_pressure(rho_i, phase_i) * (1.0 - sd.rho_w / sd.rho_s);
-        let tau_y = sd.dp_alpha * max(p_skel, 0.0) + sd.dp_kappa;
+        let tau_y = drucker_prager_yield(rho_i);
         let has_water = nearest_r2 < HUGE;
         let at_surface = has_water && kernel_mass < sd.surface_mass;
         var tau_b = 0.0;

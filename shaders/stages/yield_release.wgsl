@@ -67,9 +67,7 @@ fn yield_release(@builtin(global_invocation_id) gid: vec3<u32>) {
     // J2 = 1/2 t_ab t_ab with each off-diagonal entry twice.
     let j2 = 0.5 * (a.x * a.x + a.w * a.w + b.y * b.y) + a.y * a.y + a.z * a.z + b.x * b.x;
     let rho_i = textureLoad(vel_rho, texel(i), 0).w;
-    let p_skel = tait_pressure(rho_i, sd.phase) * (1.0 - sd.rho_w / sd.rho_s);
-    let tau_y = sd.dp_alpha * max(p_skel, 0.0) + sd.dp_kappa;
-    if (sqrt(j2) > FLOW_ONSET * tau_y) {
+    if (sqrt(j2) > FLOW_ONSET * drucker_prager_yield(rho_i)) {
         regions[ids[i]] = REGION_YIELDED;
     }
 }
