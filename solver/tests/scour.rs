@@ -208,7 +208,7 @@ fn ulbra_erosion_grows_with_bed_roughness() {
 
 /// Bounds of the Louvain test, in dp. The bed is 12 dp deep; before un-yielded sediment was
 /// held, its capped viscosity let the dam break shear it to the floor (the bottom row at the
-/// gate slid 54 mm by 0.25 s, up to 16 dp of moving sand in a column).
+/// gate slid 78 mm on average by 0.25 s, up to 16 dp of moving sand in a column).
 /// - The moving layer (regions 2-4), as the depth the sand it holds would fill across a 5 cm
 ///   column, averaged over the columns where sand moves: a transport layer of a few grains,
 ///   at most 5 dp = 7 d50 (measured 2.3-4.1 dp over the four times in three runs).

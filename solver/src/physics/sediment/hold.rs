@@ -32,7 +32,8 @@
 //! 0.03 1/s for the Louvain bed: it stays where it is. Released at tau_y instead, a particle
 //! flows and transmits 2 tau_y of its own to the one below, whose yield stress is larger by
 //! only a factor `1 + dp / depth`: the release runs down to the floor whatever the load (seen
-//! on the Louvain case at dp = 5 mm: the bottom row at the gate slid 54 mm by t = 0.25 s).
+//! on the Louvain case at dp = 5 mm: the bottom row at the gate slid 54 mm on average by
+//! t = 0.25 s).
 //! Once moving, a particle is held again when the stress it carries falls below tau_y itself:
 //! it takes twice the stress to start the bed as to keep it going, static friction above
 //! dynamic, as in a granular bed.
