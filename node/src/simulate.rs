@@ -11,6 +11,14 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+/// Whether an output at `t_s`, the one after `before_s`, is the first at or past a quarter of
+/// a run to `end_s`: the bed plot's panels, as the paper's Figs. 13-16 show the Louvain bed at
+/// 0.25, 0.5, 0.75 and 1 s. 1e-9 keeps an output on a quarter from missing it by round-off.
+fn passes_a_quarter(before_s: f64, t_s: f64, end_s: f64) -> bool {
+    let quarter = |t: f64| (4.0 * t / end_s + 1e-9).floor();
+    quarter(t_s) > quarter(before_s)
+}
+
 pub fn run(args: &SimulateArgs) -> Result<()> {
     // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
     let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
@@ -64,9 +72,6 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let started = Instant::now();
     let mut last = recorder.record(&sim, 0)?;
     let initial_profile = last.profile.clone();
-    // The bed plot's panels: the first output at or past each quarter of the run, as the
-    // paper's Figs. 13-16 show the Louvain bed at 0.25, 0.5, 0.75 and 1 s.
-    let mut quarters = (1..=4).map(|q| f64::from(q) * end_s / 4.0).peekable();
     let mut bed_profiles = Vec::new();
     for k in 1..=intervals {
         let target_s = (k as f64 * interval_s).min(end_s);
@@ -86,9 +91,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
                 out_dir.display()
             )));
         }
+        let before_s = last.time_s;
         last = recorder.record(&sim, k)?;
-        if quarters.next_if(|&q| last.time_s >= q - 1e-9).is_some() {
-            while quarters.next_if(|&q| last.time_s >= q - 1e-9).is_some() {}
+        if passes_a_quarter(before_s, last.time_s, end_s) {
             bed_profiles.push((last.time_s, last.profile.clone()));
         }
         let wall = started.elapsed().as_secs_f64();
@@ -212,4 +217,38 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
     ]);
     println!();
     print!("{t}");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::passes_a_quarter;
+
+    /// The panels a run with outputs every `interval_s` to `end_s` gets.
+    fn panels(interval_s: f64, end_s: f64) -> Vec<f64> {
+        let n = ((end_s / interval_s) - 1e-9).ceil() as u64;
+        let times: Vec<f64> = (0..=n)
+            .map(|k| (k as f64 * interval_s).min(end_s))
+            .collect();
+        times
+            .windows(2)
+            .filter(|w| passes_a_quarter(w[0], w[1], end_s))
+            .map(|w| w[1])
+            .collect()
+    }
+
+    #[test]
+    fn the_bed_plot_shows_the_first_output_at_each_quarter() {
+        // Louvain: 0.05 s outputs to 1 s land on the quarters, however 0.05 k rounds.
+        let louvain = panels(0.05, 1.0);
+        assert_eq!(louvain.len(), 4, "{louvain:?}");
+        for (t, q) in louvain.iter().zip([0.25, 0.5, 0.75, 1.0]) {
+            assert!((t - q).abs() < 1e-12, "{louvain:?}");
+        }
+        // Outputs coarser than a quarter: one panel each, never two for one output.
+        assert_eq!(panels(0.5, 1.0), vec![0.5, 1.0]);
+        // Outputs between the quarters: the first past each, one panel for an output past two
+        // (0.8 s passes 0.5 and 0.75), and the shortened last one.
+        assert_eq!(panels(0.4, 1.0), vec![0.4, 0.8, 1.0]);
+        assert_eq!(panels(0.05, 0.05), vec![0.05]);
+    }
 }

@@ -92,9 +92,7 @@ fn a_drop_at_the_speed_of_the_pit_splash_is_neither_excluded_nor_fatal() {
 }
 
 /// A real blow-up (CFL 5, 25 times the case's, on a flowing flume) is not passed off as
-/// splashes: it is caught, rolled back and retried, and the flags say why. Held sand is never
-/// excluded (it is no splash), so a held bed whose density runs away is a blow-up too: the
-/// error then names held sand (at rest) outside the range.
+/// splashes: it is caught, rolled back and retried, and the flags say why.
 #[test]
 fn an_unstable_step_in_a_flume_is_still_a_blow_up() {
     let _l = common::gpu_lock();
@@ -108,17 +106,11 @@ fn an_unstable_step_in_a_flume_is_still_a_blow_up() {
     eprintln!("result {result:?}, recoveries {:?}", sim.recoveries());
     let first = sim.recoveries().first().expect("CFL 5 was not caught");
     let caught = Health::NON_FINITE | Health::MANY_EXCLUDED | Health::DT_COLLAPSE;
-    if first.health.0 & caught == 0 {
-        assert_eq!(first.health.0, Health::DENSITY_RUNAWAY, "{}", first.health);
-        if let Err(SolverError::BlowUp { culprits, .. }) = &result {
-            let held_out = culprits.iter().any(|c| {
-                c.phase == "sand"
-                    && c.velocity_m_per_s == [0.0, 0.0]
-                    && (c.density_kg_per_m3 / c.rest_density_kg_per_m3 - 1.0).abs() > 0.3
-            });
-            assert!(held_out, "a density runaway not of held sand: {culprits:?}");
-        }
-    }
+    assert!(
+        first.health.0 & caught != 0,
+        "caught for {}, not for the state going bad",
+        first.health
+    );
     assert!(first.cfl < 5.0);
 }
 
