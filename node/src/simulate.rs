@@ -6,9 +6,8 @@ use crate::output::{bed_plot, recorder::Recorder};
 use crate::progress;
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
-use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation, SolverError};
+use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation, SolverError};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Whether an output at `t_s`, the one after `before_s`, is the first at or past a quarter of
@@ -45,9 +44,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         Some(path) => Some(InflowSeries::from_path(path)?),
     };
 
-    let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
-    println!("adapter: {}", gpu.adapter);
-    let mut sim = Simulation::new(gpu, &case).context("cannot set up the simulation")?;
+    let backend = Backend::choose(&case).context("cannot open a backend")?;
+    let mut sim = Simulation::new(backend, &case).context("cannot set up the simulation")?;
+    println!("adapter: {}", sim.backend_name());
     print_case(&args.case, &case, &sim);
     if let Some(series) = &inflow {
         set_inflow(&mut sim, series, 0.0)?;

@@ -6,9 +6,8 @@ use crate::output::recorder::Recorder;
 use crate::visual::CloudPoint;
 use anyhow::{Context, Result};
 use flume_solver::case::Particles;
-use flume_solver::{BoundaryConditions, Case, GpuContext, Observations, Simulation};
+use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation};
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 use std::time::Instant;
@@ -78,17 +77,17 @@ pub fn spawn(
     let handle = std::thread::Builder::new()
         .name("flume-solver".into())
         .spawn(move || {
-            let started = (|| -> Result<(Arc<GpuContext>, Simulation, Option<Recorder>)> {
-                let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
-                let sim = Simulation::new(Arc::clone(&gpu), &case)
+            let started = (|| -> Result<(Backend, Simulation, Option<Recorder>)> {
+                let backend = Backend::choose(&case).context("cannot open a backend")?;
+                let sim = Simulation::new(backend.clone(), &case)
                     .context("cannot set up the simulation")?;
                 let recorder = match &out {
                     Some(dir) => Some(Recorder::create(dir, &case, None)?),
                     None => None,
                 };
-                Ok((gpu, sim, recorder))
+                Ok((backend, sim, recorder))
             })();
-            let (gpu, mut sim, mut recorder) = match started {
+            let (backend, mut sim, mut recorder) = match started {
                 Ok(s) => s,
                 Err(e) => {
                     let _ = ready_tx.send(Err(format!("{e:#}")));
@@ -154,7 +153,7 @@ pub fn spawn(
                     }),
                     Command::Reset => {
                         let started = Instant::now();
-                        Simulation::new(Arc::clone(&gpu), &case)
+                        Simulation::new(backend.clone(), &case)
                             .map_err(|e| format!("cannot rebuild the case: {e}"))
                             .and_then(|fresh| {
                                 sim = fresh;
@@ -193,7 +192,7 @@ pub fn spawn(
 }
 
 fn sim_adapter(sim: &Simulation) -> String {
-    sim.gpu().adapter.to_string()
+    sim.backend_name()
 }
 
 fn observe(

@@ -5,8 +5,11 @@
 //! Start at `pipeline.rs`: its step lists every stage; each stage name leads to its WGSL file
 //! in `shaders/stages/`, its spec in `stages.rs` and its CPU oracle in `physics`.
 
+pub mod backend;
 pub mod case;
 pub mod config;
+pub mod cpu;
+pub mod engine;
 pub mod flume;
 pub mod gpu;
 pub mod health;
@@ -16,6 +19,7 @@ pub mod pipeline;
 pub mod simulation;
 pub mod stages;
 
+pub use backend::Backend;
 pub use config::{Case, ConfigError};
 pub use flume::BoundaryConditions;
 pub use gpu::{GpuContext, GpuError};

@@ -3,20 +3,20 @@
 //! Absolute time is kept here in f64; the GPU only sees the time since the start of the
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s).
 
+use crate::backend::Backend;
 use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
+use crate::engine::{Engine, StageTime};
 use crate::flume::{
     BoundaryConditions, FlumeState, MAX_INLET_MACH, max_inflow_m3_per_s, parked_slots,
 };
-use crate::gpu::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
+use crate::gpu::GpuError;
+use crate::gpu::engine::{GpuEngine, PipelineShape, by_id};
 use crate::gpu::params::*;
-use crate::gpu::{GpuContext, GpuError};
 use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
-use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
 use bytemuck::Zeroable;
-use std::sync::Arc;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SolverError {
@@ -59,6 +59,8 @@ pub enum SolverError {
         density_error: f64,
         c0_needed_m_per_s: f64,
     },
+    #[error("the CPU backend {0}; run it on a GPU adapter (unset FLUME_TWIN_ADAPTER, or name one)")]
+    CpuUnsupported(String),
     #[error("parameter `{name}` refused: {reason}")]
     InvalidParameter { name: &'static str, reason: String },
 }
@@ -78,12 +80,9 @@ pub const MAX_CFL: f64 = 5.0;
 const MAX_STEPS_PER_SUBMIT: u32 = 400;
 
 pub struct Simulation {
-    gpu: Arc<GpuContext>,
+    engine: Box<dyn Engine>,
     case: Case,
     derived: Derived,
-    pipeline: SphPipeline,
-    buffers: GpuBuffers,
-    bindings: Bindings,
     params: SimParams,
     probes: observe::ProbeLayout,
     time_s: f64,
@@ -140,7 +139,8 @@ fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverE
 }
 
 impl Simulation {
-    pub fn new(gpu: Arc<GpuContext>, case: &Case) -> Result<Simulation, SolverError> {
+    pub fn new(backend: impl Into<Backend>, case: &Case) -> Result<Simulation, SolverError> {
+        let backend = backend.into();
         let derived = case::derive(case);
         let count = case::count(case);
         let (grid_dims, _) = grid_for(case, derived.h, count)?;
@@ -149,7 +149,9 @@ impl Simulation {
         if count >= u64::from(u32::MAX / 2) {
             return Err(SolverError::TooManyParticles(count));
         }
-        GpuBuffers::check_limits(&gpu, count, n_cells)?;
+        if let Backend::Gpu(gpu) = &backend {
+            crate::pipeline::GpuBuffers::check_limits(gpu, count, n_cells)?;
+        }
         crate::flume::check_inflow(case)?;
         let particles = case::generate(case, &derived);
         // A sound speed too low for the fluid's height starts outside the weakly compressible
@@ -172,19 +174,18 @@ impl Simulation {
                     .sqrt(),
             });
         }
-        Self::from_particles(gpu, case, particles)
+        Self::from_particles(backend, case, particles)
     }
 
     /// A simulation of `case` that starts from the given particles instead of the case's
     /// lattice (a restored snapshot, or a test's perturbed state); phases index the case's table.
     pub fn from_particles(
-        gpu: Arc<GpuContext>,
+        backend: impl Into<Backend>,
         case: &Case,
         particles: Particles,
     ) -> Result<Simulation, SolverError> {
         let derived = case::derive(case);
         let (grid_dims, grid_origin) = grid_for(case, derived.h, particles.len() as u64)?;
-        GpuBuffers::check_limits(&gpu, particles.len() as u64, u64::from(grid_dims[3]))?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);
         let params = sim_params(
@@ -195,53 +196,51 @@ impl Simulation {
             grid_origin,
             probes.points.len() as u32,
         );
-        let a = StateBuffers {
-            positions: storage_init(&gpu, "a.positions", &particles.positions),
-            vel_rho: storage_init(&gpu, "a.vel_rho", &particles.vel_rho),
-            ids: storage_init(&gpu, "a.ids", &particles.ids),
-            vel_rho_prev: storage_init(&gpu, "a.vel_rho_prev", &particles.vel_rho),
-        };
-        let buffers = GpuBuffers::new(
-            &gpu,
-            uniform_init(&gpu, "params", &params),
-            a,
-            params.n_cells,
-            params.n_probes,
-        );
-        gpu.queue.write_buffer(
-            &buffers.probe_points,
-            0,
-            bytemuck::cast_slice(&probes.points),
-        );
-        let verlet = matches!(case.numerics.integrator, Integrator::Verlet { .. });
-        let flume = FlumeState::new(case, &particles);
         let multiphase = matches!(case.numerics.viscosity, Viscosity::Multiphase { .. });
         let drucker_prager = case
             .phases
             .iter()
             .filter_map(|p| p.sediment.as_ref())
             .any(|s| s.criterion == YieldCriterion::DruckerPragerShields);
-        let pipeline = SphPipeline::new(
-            &gpu,
-            case.dimension,
-            divisions_of(case, derived.h),
-            verlet,
+        let shape = PipelineShape {
+            dim: case.dimension,
+            divisions: divisions_of(case, derived.h),
+            verlet: matches!(case.numerics.integrator, Integrator::Verlet { .. }),
             multiphase,
-            multiphase && drucker_prager,
-        );
-        let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);
+            yield_release: multiphase && drucker_prager,
+        };
+        let engine: Box<dyn Engine> = match backend.into() {
+            Backend::Gpu(gpu) => Box::new(GpuEngine::new(
+                gpu,
+                &params,
+                &particles,
+                &probes.points,
+                shape,
+            )?),
+            Backend::Cpu { threads } => {
+                if let Some(why) = crate::cpu::unsupported(case) {
+                    return Err(SolverError::CpuUnsupported(why));
+                }
+                Box::new(crate::cpu::CpuEngine::new(
+                    threads,
+                    &params,
+                    derived.phases.len(),
+                    &particles,
+                    &probes.points,
+                    shape,
+                )?)
+            }
+        };
+        let flume = FlumeState::new(case, &particles);
         let max_excluded = health::max_excluded_per_chunk(
             (0..particles.len())
                 .filter(|&i| particles.phase(i) != WALL_PHASE)
                 .count(),
         );
         Ok(Simulation {
-            gpu,
+            engine,
             case: case.clone(),
             derived,
-            pipeline,
-            buffers,
-            bindings,
             params,
             probes,
             time_s: 0.0,
@@ -265,8 +264,13 @@ impl Simulation {
     pub fn derived(&self) -> &Derived {
         &self.derived
     }
-    pub fn gpu(&self) -> &GpuContext {
-        &self.gpu
+    /// The backend and device the simulation runs on.
+    pub fn backend_name(&self) -> String {
+        self.engine.name()
+    }
+    /// Time per stage since the start; empty where the backend cannot time stages apart.
+    pub fn stage_times(&self) -> Vec<StageTime> {
+        self.engine.stage_times()
     }
     pub fn particle_count(&self) -> usize {
         self.initial_particles.len()
@@ -314,8 +318,7 @@ impl Simulation {
         }
         let saved = (self.time_s, self.steps, self.last_dt_s, self.dt_taken);
         let saved_flume = self.flume.clone();
-        self.copy_state(&self.buffers.a, &self.buffers.snapshot);
-        self.copy_holds(&self.buffers.regions, &self.buffers.regions_snapshot);
+        self.engine.save();
         let mut tries = 0;
         // When the first try failed, and whether every retry failed at about the same time:
         // an unstable step fails after about as many steps whatever their length, so halving
@@ -356,14 +359,11 @@ impl Simulation {
             }
             tries += 1;
             self.clean_chunks = 0;
-            self.copy_state(&self.buffers.snapshot, &self.buffers.a);
-            self.copy_holds(&self.buffers.regions_snapshot, &self.buffers.regions);
+            self.engine.restore();
             (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
             self.flume.clone_from(&saved_flume);
             self.params.cfl *= 0.5;
-            self.gpu
-                .queue
-                .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+            self.engine.write_params(&self.params);
             log::warn!(
                 "blow-up at t = {time_s:.6} s (step {step}): {health}; worst particles: {}; restored t = {:.6} s, retrying with CFL {}",
                 health::list(&culprits),
@@ -387,9 +387,7 @@ impl Simulation {
         if self.clean_chunks >= CFL_RESTORE_AFTER_CHUNKS {
             self.clean_chunks = 0;
             self.params.cfl = (2.0 * self.params.cfl).min(self.cfl_target);
-            self.gpu
-                .queue
-                .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+            self.engine.write_params(&self.params);
             log::info!(
                 "{CFL_RESTORE_AFTER_CHUNKS} calm chunks: CFL back up to {}",
                 self.params.cfl
@@ -417,31 +415,8 @@ impl Simulation {
         }
         self.params.cfl = cfl as f32;
         self.cfl_target = cfl as f32;
-        self.gpu
-            .queue
-            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        self.engine.write_params(&self.params);
         Ok(())
-    }
-
-    /// Copies the region words (with the holds of the Drucker-Prager mode, which the next
-    /// rheology pass starts from).
-    fn copy_holds(&self, from: &wgpu::Buffer, to: &wgpu::Buffer) {
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(from, 0, to, 0, from.size());
-        self.gpu.queue.submit([encoder.finish()]);
-    }
-
-    fn copy_state(&self, from: &StateBuffers, to: &StateBuffers) {
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        for (src, dst) in [
-            (&from.positions, &to.positions),
-            (&from.vel_rho, &to.vel_rho),
-            (&from.ids, &to.ids),
-            (&from.vel_rho_prev, &to.vel_rho_prev),
-        ] {
-            encoder.copy_buffer_to_buffer(src, 0, dst, 0, src.size());
-        }
-        self.gpu.queue.submit([encoder.finish()]);
     }
 
     /// Steps to `target_s` in submissions of up to `MAX_STEPS_PER_SUBMIT` steps. Each
@@ -463,11 +438,7 @@ impl Simulation {
                 self.dt_taken,
                 (self.steps % euler_every) as u32,
             );
-            self.gpu
-                .queue
-                .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&init));
-            self.submit_steps(self.steps_for(span));
-            let state = self.read_state()?;
+            let state = self.engine.run(init, self.steps_for(span))?;
             self.steps += u64::from(state.steps);
             self.last_dt_s = f64::from(state.last_dt);
             self.dt_taken = state.dt_taken;
@@ -557,11 +528,8 @@ impl Simulation {
         }
         let heights = f.column_heights(dp);
         let u = f.inlet_velocity() as f32;
-        let n = self.initial_particles.len() as u64;
-        let a = &self.buffers.a;
-        let raw = read_buffers(&self.gpu, &[(&a.positions, n * 16), (&a.ids, n * 4)])?;
-        let positions: Vec<[f32; 4]> = cast_vec(&raw[0]);
-        let ids: Vec<u32> = cast_vec(&raw[1]);
+        let raw = self.engine.read_state()?;
+        let (positions, ids) = (raw.positions, raw.ids);
         let fl = self.params.flume;
         // The buffer keeps the density its particles enter with (store_state.wgsl): rest.
         let rho = self.params.phases[fl.water_phase as usize].rho0;
@@ -587,13 +555,8 @@ impl Simulation {
                     starved += 1;
                     continue;
                 };
-                let offset = slot as u64 * 16;
                 let pos = [x as f32, y as f32, 0.0, f32::from_bits(fl.water_phase)];
-                let vr = [u, 0.0, 0.0, rho];
-                let q = &self.gpu.queue;
-                q.write_buffer(&a.positions, offset, bytemuck::bytes_of(&pos));
-                q.write_buffer(&a.vel_rho, offset, bytemuck::bytes_of(&vr));
-                q.write_buffer(&a.vel_rho_prev, offset, bytemuck::bytes_of(&vr));
+                self.engine.place(slot, pos, [u, 0.0, 0.0, rho]);
                 placed += 1;
             }
         }
@@ -639,9 +602,7 @@ impl Simulation {
         }
         f.inflow_m3_per_s = q;
         self.params.flume.inlet_u = u as f32;
-        self.gpu
-            .queue
-            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&self.params));
+        self.engine.write_params(&self.params);
         Ok(())
     }
 
@@ -663,126 +624,33 @@ impl Simulation {
             .clamp(1.0, f64::from(MAX_STEPS_PER_SUBMIT)) as u32
     }
 
-    fn submit_steps(&self, steps: u32) {
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("steps"),
-            });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("sph steps"),
-                timestamp_writes: None,
-            });
-            for _ in 0..steps {
-                self.pipeline.record_step(&mut pass, &self.bindings);
-            }
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-    }
-
-    fn read_state(&self) -> Result<StepState, GpuError> {
-        let bytes = read_buffers(
-            &self.gpu,
-            &[(&self.buffers.state, std::mem::size_of::<StepState>() as u64)],
-        )?;
-        Ok(bytemuck::pod_read_unaligned(&bytes[0]))
-    }
-
     /// The particles as they are now, in id order (index i holds the particle generated i-th).
     pub fn read_particles(&self) -> Result<Particles, SolverError> {
-        let n = self.particle_count() as u64;
-        let a = &self.buffers.a;
-        let raw = read_buffers(
-            &self.gpu,
-            &[
-                (&a.positions, n * 16),
-                (&a.vel_rho, n * 16),
-                (&a.ids, n * 4),
-            ],
-        )?;
-        let positions: Vec<[f32; 4]> = cast_vec(&raw[0]);
-        let vel_rho: Vec<[f32; 4]> = cast_vec(&raw[1]);
-        let ids: Vec<u32> = cast_vec(&raw[2]);
-        let mut out = Particles {
-            positions: vec![[0.0; 4]; n as usize],
-            vel_rho: vec![[0.0; 4]; n as usize],
-            ids: (0..n as u32).collect(),
-        };
-        for (k, &id) in ids.iter().enumerate() {
-            let i = id as usize;
-            if i < out.positions.len() {
-                out.positions[i] = positions[k];
-                out.vel_rho[i] = vel_rho[k];
-            }
-        }
-        Ok(out)
+        let raw = self.engine.read_state()?;
+        Ok(Particles {
+            positions: by_id(&raw.positions, &raw.ids),
+            vel_rho: by_id(&raw.vel_rho, &raw.ids),
+            ids: (0..raw.ids.len() as u32).collect(),
+        })
     }
 
     /// Region words of the last rheology pass (and release of held sediment), in id order: the
     /// region 1-5 of Figure 2 (0 for walls, and for every particle when the case has no
     /// multiphase viscosity), plus 256 for sediment held fixed in that pass.
     pub fn regions(&self) -> Result<Vec<u32>, SolverError> {
-        let n = self.particle_count() as u64;
-        let raw = read_buffers(&self.gpu, &[(&self.buffers.regions, n * 4)])?;
-        Ok(cast_vec(&raw[0]))
+        self.engine.regions()
     }
 
     /// Forces and density rates (x, y, z acceleration, d rho/dt) of the current state, in id
     /// order, and the smallest stable step over particles (before the CFL factor), without
-    /// advancing: the GPU side of the force-stage test.
+    /// advancing: the backend's side of the force-stage tests.
     pub fn compute_forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
-        // A chunk that has not ended, so the force pass runs.
-        let open = StepState::chunk(f32::MAX, 0.0, 0.0, 0);
-        self.gpu
-            .queue
-            .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(&open));
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.pipeline.record_forces(&mut pass, &self.bindings);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        let n = self.particle_count() as u64;
-        let raw = read_buffers(
-            &self.gpu,
-            &[
-                (&self.buffers.forces, n * 16),
-                (&self.buffers.b_ids, n * 4),
-                (&self.buffers.state, std::mem::size_of::<StepState>() as u64),
-            ],
-        )?;
-        let forces: Vec<[f32; 4]> = cast_vec(&raw[0]);
-        let ids: Vec<u32> = cast_vec(&raw[1]);
-        let state: StepState = bytemuck::pod_read_unaligned(&raw[2]);
-        let mut out = vec![[0.0; 4]; n as usize];
-        for (k, &id) in ids.iter().enumerate() {
-            if let Some(slot) = out.get_mut(id as usize) {
-                *slot = forces[k];
-            }
-        }
-        Ok((out, f32::from_bits(state.dt_min_bits)))
+        self.engine.forces()
     }
 
     /// The cell list of the current state: (cell starts, particle ids in sorted order).
     pub fn cell_list(&self) -> Result<(Vec<u32>, Vec<u32>), SolverError> {
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.pipeline.record_sort(&mut pass, &self.bindings);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        let n = self.particle_count() as u64;
-        let cells = u64::from(self.params.n_cells) + 1;
-        let raw = read_buffers(
-            &self.gpu,
-            &[
-                (&self.buffers.cell_starts, cells * 4),
-                (&self.buffers.b_ids, n * 4),
-            ],
-        )?;
-        Ok((cast_vec(&raw[0]), cast_vec(&raw[1])))
+        self.engine.cell_list()
     }
 
     pub fn params(&self) -> &SimParams {
@@ -791,33 +659,7 @@ impl Simulation {
 
     /// Gauges, probes, front and health at the current time.
     pub fn observe(&self) -> Result<Observations, SolverError> {
-        let reset = Extremes {
-            front_key: 0,
-            max_speed_bits: 0,
-            max_rho_err_bits: 0,
-            fluid_count: 0,
-        };
-        self.gpu
-            .queue
-            .write_buffer(&self.buffers.extremes, 0, bytemuck::bytes_of(&reset));
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.pipeline.record_observe(&mut pass, &self.bindings);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        let raw = read_buffers(
-            &self.gpu,
-            &[
-                (
-                    &self.buffers.probe_sums,
-                    self.probes.points.len() as u64 * 16,
-                ),
-                (&self.buffers.extremes, 16),
-            ],
-        )?;
-        let sums: Vec<[f32; 4]> = cast_vec(&raw[0]);
-        let ext: Extremes = bytemuck::pod_read_unaligned(&raw[1]);
+        let (sums, ext) = self.engine.observe()?;
         let mut obs =
             self.probes
                 .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext);

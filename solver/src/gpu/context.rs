@@ -152,6 +152,11 @@ impl GpuContext {
         })
     }
 
+    /// Whether the adapter is a software rasteriser on the CPU (lavapipe, llvmpipe).
+    pub fn is_software(&self) -> bool {
+        self.adapter.device_type == format!("{:?}", wgpu::DeviceType::Cpu)
+    }
+
     /// Fails with `TooLarge` if a storage buffer of `bytes` would exceed the adapter's limits.
     pub fn check_storage_size(&self, buffer: &str, bytes: u64) -> Result<(), GpuError> {
         let limit = self

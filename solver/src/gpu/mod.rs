@@ -2,6 +2,7 @@
 
 pub mod buffers;
 pub mod context;
+pub mod engine;
 pub mod params;
 pub mod shader;
 pub mod stage;

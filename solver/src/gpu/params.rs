@@ -196,3 +196,46 @@ pub struct ScanInfo {
     pub n: u32,
     pub pad: [u32; 3],
 }
+
+/// Maps f32 to u32 so that unsigned order is float order (negative values too); mirrors the
+/// shader's `order_key` in observe_reduce.wgsl.
+pub fn order_key(x: f32) -> u32 {
+    let b = x.to_bits();
+    if b & 0x8000_0000 != 0 {
+        !b
+    } else {
+        b | 0x8000_0000
+    }
+}
+
+impl SimParams {
+    /// The pair and particle formulas' parameters (`solver::physics`) for this uniform, of a
+    /// case in `dim` dimensions with `n_phases` phases (walls included).
+    pub fn physics(&self, dim: u32, n_phases: usize) -> crate::physics::Params {
+        use crate::physics::{Params, Phase, Viscosity};
+        Params {
+            dim,
+            h: self.h,
+            c0: self.c0,
+            gravity: [self.gravity[0], self.gravity[1], self.gravity[2]],
+            delta: self.delta_h_c0 / (self.h * self.c0),
+            hydrostatic_diffusion: self.diffusion_mode == DIFFUSION_FOURTAKAS,
+            clamp_negative_pressure: self.clamp_pressure != 0,
+            viscosity: match self.viscosity_mode {
+                VISCOSITY_ARTIFICIAL => Viscosity::Artificial { alpha: self.alpha },
+                VISCOSITY_LAMINAR => Viscosity::Laminar,
+                _ => Viscosity::Multiphase { alpha: self.alpha },
+            },
+            cfl: self.cfl,
+            phases: self.phases[..n_phases.min(MAX_PHASES)]
+                .iter()
+                .map(|ph| Phase {
+                    rho0: ph.rho0,
+                    mass: ph.mass,
+                    mu: ph.mu,
+                    mobile: ph.mobile > 0.5,
+                })
+                .collect(),
+        }
+    }
+}

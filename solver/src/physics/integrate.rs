@@ -10,7 +10,102 @@
 use super::Phase;
 use super::interaction::phase_index;
 
-/// Predictor: state at t + dt/2 from the state and forces at t.
+/// One particle's predictor half step: its position and velocity-density at t + dt/2 from
+/// those at t and its forces `f` at t. A wall keeps its position and velocity, and
+/// `rho >= rho0`.
+pub fn predict(phase: &Phase, dt: f32, x: &[f32; 4], v: &[f32; 4], f: &[f32; 4]) -> Particle {
+    let half = 0.5 * dt;
+    let rho = v[3] + half * f[3];
+    if !phase.mobile {
+        return (*x, [v[0], v[1], v[2], rho.max(phase.rho0)]);
+    }
+    (
+        [
+            x[0] + half * v[0],
+            x[1] + half * v[1],
+            x[2] + half * v[2],
+            x[3],
+        ],
+        [
+            v[0] + half * f[0],
+            v[1] + half * f[1],
+            v[2] + half * f[2],
+            rho,
+        ],
+    )
+}
+
+/// One particle's corrector full step: its state at t + dt from the state `x`, `v` at t, its
+/// density `rho_half` at t + dt/2 and its forces `f` there.
+pub fn correct(
+    phase: &Phase,
+    dt: f32,
+    x: &[f32; 4],
+    v: &[f32; 4],
+    rho_half: f32,
+    f: &[f32; 4],
+) -> Particle {
+    let eps = -(f[3] / rho_half) * dt;
+    let rho = v[3] * (2.0 - eps) / (2.0 + eps);
+    if !phase.mobile {
+        return (*x, [v[0], v[1], v[2], rho.max(phase.rho0)]);
+    }
+    let v_new = [v[0] + dt * f[0], v[1] + dt * f[1], v[2] + dt * f[2]];
+    let step = dt * 0.5;
+    (
+        [
+            x[0] + step * (v[0] + v_new[0]),
+            x[1] + step * (v[1] + v_new[1]),
+            x[2] + step * (v[2] + v_new[2]),
+            x[3],
+        ],
+        [v_new[0], v_new[1], v_new[2], rho],
+    )
+}
+
+/// One particle's Verlet step (see [`verlet`]): its state at n + 1 from the state `x`, `v` at
+/// n, its velocity-density `v_prev` at n - 1 and its forces `f` at n.
+#[allow(clippy::too_many_arguments)]
+pub fn verlet_step(
+    phase: &Phase,
+    dt: f32,
+    dt_prev: f32,
+    euler: bool,
+    x: &[f32; 4],
+    v: &[f32; 4],
+    v_prev: &[f32; 4],
+    f: &[f32; 4],
+) -> Particle {
+    let (from, span) = if euler {
+        (v, dt)
+    } else {
+        (v_prev, dt_prev + dt)
+    };
+    let rho = from[3] + span * f[3];
+    if !phase.mobile {
+        return (*x, [v[0], v[1], v[2], rho.max(phase.rho0)]);
+    }
+    let half_dt2 = 0.5 * dt * dt;
+    (
+        [
+            x[0] + dt * v[0] + half_dt2 * f[0],
+            x[1] + dt * v[1] + half_dt2 * f[1],
+            x[2] + dt * v[2] + half_dt2 * f[2],
+            x[3],
+        ],
+        [
+            from[0] + span * f[0],
+            from[1] + span * f[1],
+            from[2] + span * f[2],
+            rho,
+        ],
+    )
+}
+
+/// A particle's position and velocity-density.
+pub type Particle = ([f32; 4], [f32; 4]);
+
+/// Predictor: state at t + dt/2 from the state and forces at t, by [`predict`].
 ///
 /// Returns `(pos_half, vel_rho_half)`. Panics if the slices differ in length or a phase index is
 /// outside `phases` (caller bugs).
@@ -21,44 +116,24 @@ pub fn predictor(
     vel_rho: &[[f32; 4]],
     forces: &[[f32; 4]],
 ) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
-    assert_eq!(
-        pos.len(),
-        vel_rho.len(),
-        "positions and velocities differ in length"
+    assert!(
+        pos.len() == vel_rho.len() && pos.len() == forces.len(),
+        "predictor inputs differ in length"
     );
-    assert_eq!(
-        pos.len(),
-        forces.len(),
-        "positions and forces differ in length"
-    );
-    let half = 0.5 * dt;
-    let mut pos_half = Vec::with_capacity(pos.len());
-    let mut vel_rho_half = Vec::with_capacity(pos.len());
-    for ((x, v), f) in pos.iter().zip(vel_rho).zip(forces) {
-        let phase = &phases[phase_index(x)];
-        let rho = v[3] + half * f[3];
-        if phase.mobile {
-            pos_half.push([
-                x[0] + half * v[0],
-                x[1] + half * v[1],
-                x[2] + half * v[2],
-                x[3],
-            ]);
-            vel_rho_half.push([
-                v[0] + half * f[0],
-                v[1] + half * f[1],
-                v[2] + half * f[2],
-                rho,
-            ]);
-        } else {
-            pos_half.push(*x);
-            vel_rho_half.push([v[0], v[1], v[2], rho.max(phase.rho0)]);
-        }
-    }
-    (pos_half, vel_rho_half)
+    (0..pos.len())
+        .map(|i| {
+            predict(
+                &phases[phase_index(&pos[i])],
+                dt,
+                &pos[i],
+                &vel_rho[i],
+                &forces[i],
+            )
+        })
+        .unzip()
 }
 
-/// Corrector: state at t + dt from the state at t and the forces at t + dt/2.
+/// Corrector: state at t + dt from the state at t and the forces at t + dt/2, by [`correct`].
 ///
 /// Returns `(pos_new, vel_rho_new)`. Panics if the slices differ in length or a phase index is
 /// outside `phases` (caller bugs).
@@ -75,29 +150,19 @@ pub fn corrector(
         vel_rho_n.len() == n && vel_rho_half.len() == n && forces_half.len() == n,
         "corrector inputs differ in length"
     );
-    let mut pos_new = Vec::with_capacity(n);
-    let mut vel_rho_new = Vec::with_capacity(n);
-    for i in 0..n {
-        let (x, v, vh, f) = (&pos_n[i], &vel_rho_n[i], &vel_rho_half[i], &forces_half[i]);
-        let phase = &phases[phase_index(x)];
-        let eps = -(f[3] / vh[3]) * dt;
-        let rho = v[3] * (2.0 - eps) / (2.0 + eps);
-        if phase.mobile {
-            let v_new = [v[0] + dt * f[0], v[1] + dt * f[1], v[2] + dt * f[2]];
-            let step = dt * 0.5;
-            pos_new.push([
-                x[0] + step * (v[0] + v_new[0]),
-                x[1] + step * (v[1] + v_new[1]),
-                x[2] + step * (v[2] + v_new[2]),
-                x[3],
-            ]);
-            vel_rho_new.push([v_new[0], v_new[1], v_new[2], rho]);
-        } else {
-            pos_new.push(*x);
-            vel_rho_new.push([v[0], v[1], v[2], rho.max(phase.rho0)]);
-        }
-    }
-    (pos_new, vel_rho_new)
+    (0..n)
+        .map(|i| {
+            let phase = &phases[phase_index(&pos_n[i])];
+            correct(
+                phase,
+                dt,
+                &pos_n[i],
+                &vel_rho_n[i],
+                vel_rho_half[i][3],
+                &forces_half[i],
+            )
+        })
+        .unzip()
 }
 
 /// Positions, velocity-density and previous velocity-density of all particles.
@@ -127,31 +192,22 @@ pub fn verlet(
     assert!(
         pos.len() == vel_rho.len() && pos.len() == vel_rho_prev.len() && pos.len() == forces.len()
     );
-    let mut pos_new = Vec::with_capacity(pos.len());
-    let mut vel_new = Vec::with_capacity(pos.len());
-    for (((x, v), vp), f) in pos.iter().zip(vel_rho).zip(vel_rho_prev).zip(forces) {
-        let phase = &phases[phase_index(x)];
-        let (from, span) = if euler { (v, dt) } else { (vp, dt_prev + dt) };
-        let rho = from[3] + span * f[3];
-        if phase.mobile {
-            let half_dt2 = 0.5 * dt * dt;
-            pos_new.push([
-                x[0] + dt * v[0] + half_dt2 * f[0],
-                x[1] + dt * v[1] + half_dt2 * f[1],
-                x[2] + dt * v[2] + half_dt2 * f[2],
-                x[3],
-            ]);
-            vel_new.push([
-                from[0] + span * f[0],
-                from[1] + span * f[1],
-                from[2] + span * f[2],
-                rho,
-            ]);
-        } else {
-            pos_new.push(*x);
-            vel_new.push([v[0], v[1], v[2], rho.max(phase.rho0)]);
-        }
-    }
+    let (pos_new, vel_new) = (0..pos.len())
+        .map(|i| {
+            let phase = &phases[phase_index(&pos[i])];
+            let (x, v) = (&pos[i], &vel_rho[i]);
+            verlet_step(
+                phase,
+                dt,
+                dt_prev,
+                euler,
+                x,
+                v,
+                &vel_rho_prev[i],
+                &forces[i],
+            )
+        })
+        .unzip();
     (pos_new, vel_new, vel_rho.to_vec())
 }
 

@@ -47,8 +47,186 @@ fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-fn sub3(a: &[f32; 4], b: &[f32; 4]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+/// One particle as its pairs see it: position, velocity, density, the pressure of the momentum
+/// equation and its phase index.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Side {
+    pub x: [f32; 3],
+    pub v: [f32; 3],
+    pub rho: f32,
+    pub p: f32,
+    pub phase: usize,
+}
+
+/// The running sums of one particle's pair terms.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairSum {
+    pub acc: [f32; 3],
+    pub drho: f32,
+    /// Largest `|h v_ij . x_ij / (r^2 + eta^2)|` over the pairs, m/s (the viscous step bound).
+    pub visc_max: f32,
+}
+
+/// The pair formulas of one run, with what they derive from `Params` computed once. Both the
+/// brute-force [`interact`] and the CPU backend's cell-list loops call [`PairModel::add_pair`]:
+/// it is the one statement of what a pair contributes (the WGSL force stage mirrors it).
+#[derive(Clone, Debug)]
+pub struct PairModel<'a> {
+    params: &'a Params,
+    stiffness: Vec<f32>,
+    support2: f32,
+    coincident2: f32,
+    eta2: f32,
+    /// Downward gravity (positive), for the hydrostatic density difference.
+    g: f32,
+    vertical: usize,
+}
+
+impl<'a> PairModel<'a> {
+    pub fn new(params: &'a Params) -> PairModel<'a> {
+        let h = params.h;
+        let vertical = (params.dim - 1) as usize;
+        PairModel {
+            stiffness: params
+                .phases
+                .iter()
+                .map(|ph| tait_b(params.c0, ph.rho0))
+                .collect(),
+            support2: 4.0 * h * h,
+            // Pairs closer than this are treated as coincident: x_ij carries no direction.
+            coincident2: 1e-12 * h * h,
+            eta2: 0.01 * h * h,
+            g: -params.gravity[vertical],
+            vertical,
+            params,
+        }
+    }
+
+    pub fn params(&self) -> &Params {
+        self.params
+    }
+
+    /// The pressure of the momentum equation: Tait's, without tension when the case says so.
+    pub fn pressure(&self, rho: f32, phase: usize) -> f32 {
+        let p = pressure(rho, self.params.phases[phase].rho0, self.stiffness[phase]);
+        if self.params.clamp_negative_pressure {
+            p.max(0.0)
+        } else {
+            p
+        }
+    }
+
+    /// Particle `pos`, `vel_rho` as a pair sees it.
+    pub fn side(&self, pos: &[f32; 4], vel_rho: &[f32; 4]) -> Side {
+        let phase = phase_index(pos);
+        Side {
+            x: [pos[0], pos[1], pos[2]],
+            v: [vel_rho[0], vel_rho[1], vel_rho[2]],
+            rho: vel_rho[3],
+            p: self.pressure(vel_rho[3], phase),
+            phase,
+        }
+    }
+
+    /// Adds what neighbour `j` contributes to particle `i`'s density rate and acceleration:
+    /// nothing beyond the support 2h, for a coincident pair, or between two walls.
+    #[inline]
+    pub fn add_pair(&self, i: &Side, j: &Side, sum: &mut PairSum) {
+        let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
+        let r2 = dot3(x_ij, x_ij);
+        if r2 >= self.support2 || r2 < self.coincident2 {
+            return;
+        }
+        let params = self.params;
+        let (phase_i, phase_j) = (&params.phases[i.phase], &params.phases[j.phase]);
+        // DBC as in DualSPHysics: a wall's density answers to the fluid only.
+        if !phase_i.mobile && !phase_j.mobile {
+            return;
+        }
+        let h = params.h;
+        let f = grad_factor(r2.sqrt(), h, params.dim);
+        let (m_j, rho_j) = if phase_i.mobile && !phase_j.mobile {
+            let r = wall_scale(phase_i.rho0, phase_j.rho0);
+            (phase_j.mass * r, j.rho * r)
+        } else {
+            (phase_j.mass, j.rho)
+        };
+        let v_ij = [i.v[0] - j.v[0], i.v[1] - j.v[1], i.v[2] - j.v[2]];
+        let vdotr = dot3(v_ij, x_ij);
+        // Continuity, Eq. 9: v_ij . grad_i W_ij = vdotr F.
+        sum.drho += m_j * vdotr * f;
+        if !phase_i.mobile {
+            return;
+        }
+        if params.delta > 0.0 && phase_j.mobile && j.phase == i.phase {
+            sum.drho +=
+                params.delta * h * params.c0 * self.diffusion(i, j, rho_j, r2, f) * (m_j / rho_j);
+        }
+        // Pressure gradient, Eq. 10 with sigma = -p I.
+        let mut coef = -m_j * (i.p / (i.rho * i.rho) + j.p / (rho_j * rho_j));
+        let mu_ij = h * vdotr / (r2 + self.eta2);
+        sum.visc_max = sum.visc_max.max(mu_ij.abs());
+        match params.viscosity {
+            Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } => {
+                // Only approaching pairs are damped.
+                if vdotr < 0.0 {
+                    let pi_ij = -alpha * params.c0 * mu_ij / (0.5 * (i.rho + rho_j));
+                    coef -= m_j * pi_ij;
+                }
+                for (a, x) in sum.acc.iter_mut().zip(x_ij) {
+                    *a += coef * f * x;
+                }
+            }
+            Viscosity::Laminar => {
+                // x_ij . grad_i W_ij = r2 F.
+                let s =
+                    m_j * (phase_i.mu + phase_j.mu) * (r2 * f) / (i.rho * rho_j * (r2 + self.eta2));
+                for k in 0..3 {
+                    sum.acc[k] += coef * f * x_ij[k] + s * v_ij[k];
+                }
+            }
+        }
+    }
+
+    /// The density diffusion term psi_ij (before delta h c0 V_j); the hydrostatic density
+    /// difference rho_h is subtracted so that a fluid at rest under gravity is not diffused
+    /// towards uniform density. rho_h = rho0 ((1 + x)^(1/7) - 1), x = rho0 g dz / B, by its
+    /// series: x is below 1e-3 for neighbours (dz < 2h), where three terms are exact in f32.
+    fn diffusion(&self, i: &Side, j: &Side, rho_j: f32, r2: f32, f: f32) -> f32 {
+        let rho_h = if self.params.hydrostatic_diffusion {
+            let rho0 = self.params.phases[i.phase].rho0;
+            let dz = i.x[self.vertical] - j.x[self.vertical];
+            let x = rho0 * self.g * dz / self.stiffness[i.phase];
+            rho0 * x * (1.0 / 7.0 + x * (-3.0 / 49.0 + x * (13.0 / 343.0)))
+        } else {
+            0.0
+        };
+        2.0 * (rho_j - i.rho - rho_h) * (-r2 * f) / (r2 + self.eta2)
+    }
+
+    /// Particle `i`'s `[ax, ay, az, d rho/dt]` (gravity added; zero acceleration for a wall)
+    /// and its stable step before the CFL factor, `min(sqrt(h / |a|), h / (c0 + visc_max))`
+    /// (`f32::INFINITY` for a wall); without `force_bound` (an imposed velocity) the
+    /// acceleration does not bound the step.
+    pub fn finish(&self, i: &Side, sum: &PairSum, force_bound: bool) -> ([f32; 4], f32) {
+        let params = self.params;
+        if !params.phases[i.phase].mobile {
+            return ([0.0, 0.0, 0.0, sum.drho], f32::INFINITY);
+        }
+        let mut acc = sum.acc;
+        for (a, g) in acc.iter_mut().zip(params.gravity) {
+            *a += g;
+        }
+        let a = dot3(acc, acc).sqrt();
+        let h = params.h;
+        let dt_force = if a > 0.0 && force_bound {
+            (h / a).sqrt()
+        } else {
+            f32::INFINITY
+        };
+        let dt_sound = h / (params.c0 + sum.visc_max);
+        ([acc[0], acc[1], acc[2], sum.drho], dt_force.min(dt_sound))
+    }
 }
 
 /// One force pass over all pairs closer than 2h.
@@ -61,138 +239,24 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
         vel_rho.len(),
         "positions and velocities differ in length"
     );
-    let h = params.h;
-    let c0 = params.c0;
-    let dim = params.dim;
-    let vertical = (dim - 1) as usize;
-    let support2 = 4.0 * h * h;
-    // Pairs closer than this are treated as coincident: x_ij carries no direction.
-    let coincident2 = 1e-12 * h * h;
-    let eta2 = 0.01 * h * h;
-    // Downward gravity is positive here; the sign keeps rho_h right for any orientation.
-    let g = -params.gravity[vertical];
-
-    let stiffness: Vec<f32> = params.phases.iter().map(|ph| tait_b(c0, ph.rho0)).collect();
-    let pressures: Vec<f32> = pos
+    let model = PairModel::new(params);
+    let sides: Vec<Side> = pos
         .iter()
         .zip(vel_rho)
-        .map(|(p, v)| {
-            let k = phase_index(p);
-            let p = pressure(v[3], params.phases[k].rho0, stiffness[k]);
-            if params.clamp_negative_pressure {
-                p.max(0.0)
-            } else {
-                p
-            }
-        })
+        .map(|(p, v)| model.side(p, v))
         .collect();
-
     let mut forces = Vec::with_capacity(pos.len());
     let mut dt_limit = Vec::with_capacity(pos.len());
-    for i in 0..pos.len() {
-        let pi = phase_index(&pos[i]);
-        let phase_i = &params.phases[pi];
-        let rho_i = vel_rho[i][3];
-        let p_i = pressures[i];
-        let mut acc = [0.0_f32; 3];
-        let mut drho = 0.0_f32;
-        let mut visc_max = 0.0_f32;
-
-        for j in 0..pos.len() {
-            if j == i {
-                continue;
+    for (i, side_i) in sides.iter().enumerate() {
+        let mut sum = PairSum::default();
+        for (j, side_j) in sides.iter().enumerate() {
+            if j != i {
+                model.add_pair(side_i, side_j, &mut sum);
             }
-            let x_ij = sub3(&pos[i], &pos[j]);
-            let r2 = dot3(x_ij, x_ij);
-            if r2 >= support2 || r2 < coincident2 {
-                continue;
-            }
-            let pj = phase_index(&pos[j]);
-            let phase_j = &params.phases[pj];
-            // DBC as in DualSPHysics: a wall's density answers to the fluid only.
-            if !phase_i.mobile && !phase_j.mobile {
-                continue;
-            }
-            let f = grad_factor(r2.sqrt(), h, dim);
-            let (m_j, rho_j) = if phase_i.mobile && !phase_j.mobile {
-                let r = wall_scale(phase_i.rho0, phase_j.rho0);
-                (phase_j.mass * r, vel_rho[j][3] * r)
-            } else {
-                (phase_j.mass, vel_rho[j][3])
-            };
-            let v_ij = sub3(&vel_rho[i], &vel_rho[j]);
-            let vdotr = dot3(v_ij, x_ij);
-
-            // Continuity, Eq. 9: v_ij . grad_i W_ij = vdotr F.
-            drho += m_j * vdotr * f;
-            if !phase_i.mobile {
-                continue;
-            }
-
-            // Density diffusion; the hydrostatic density difference rho_h is subtracted so that
-            // a fluid at rest under gravity is not diffused towards uniform density.
-            if params.delta > 0.0 && phase_j.mobile && pj == pi {
-                let rho0 = phase_i.rho0;
-                let dz = pos[i][vertical] - pos[j][vertical];
-                let rho_h = if params.hydrostatic_diffusion {
-                    let base = 1.0 + rho0 * g * dz / stiffness[pi];
-                    rho0 * (base.powf(1.0 / 7.0) - 1.0)
-                } else {
-                    0.0
-                };
-                let psi = 2.0 * (rho_j - rho_i - rho_h) * (-r2 * f) / (r2 + eta2);
-                drho += params.delta * h * c0 * psi * (m_j / rho_j);
-            }
-
-            // Pressure gradient, Eq. 10 with sigma = -p I.
-            let p_term = p_i / (rho_i * rho_i) + pressures[j] / (rho_j * rho_j);
-            let s = -m_j * p_term * f;
-            for k in 0..3 {
-                acc[k] += s * x_ij[k];
-            }
-
-            match params.viscosity {
-                Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } => {
-                    // Only approaching pairs are damped.
-                    if vdotr < 0.0 {
-                        let mu_ij = h * vdotr / (r2 + eta2);
-                        let pi_ij = -alpha * c0 * mu_ij / (0.5 * (rho_i + rho_j));
-                        let s = -m_j * pi_ij * f;
-                        for k in 0..3 {
-                            acc[k] += s * x_ij[k];
-                        }
-                    }
-                }
-                Viscosity::Laminar => {
-                    // x_ij . grad_i W_ij = r2 F.
-                    let s =
-                        m_j * (phase_i.mu + phase_j.mu) * (r2 * f) / (rho_i * rho_j * (r2 + eta2));
-                    for k in 0..3 {
-                        acc[k] += s * v_ij[k];
-                    }
-                }
-            }
-
-            visc_max = visc_max.max((h * vdotr / (r2 + eta2)).abs());
         }
-
-        if phase_i.mobile {
-            for (a, g) in acc.iter_mut().zip(params.gravity) {
-                *a += g;
-            }
-            let a = dot3(acc, acc).sqrt();
-            let dt_force = if a > 0.0 {
-                (h / a).sqrt()
-            } else {
-                f32::INFINITY
-            };
-            let dt_sound = h / (c0 + visc_max);
-            forces.push([acc[0], acc[1], acc[2], drho]);
-            dt_limit.push(dt_force.min(dt_sound));
-        } else {
-            forces.push([0.0, 0.0, 0.0, drho]);
-            dt_limit.push(f32::INFINITY);
-        }
+        let (f, dt) = model.finish(side_i, &sum, true);
+        forces.push(f);
+        dt_limit.push(dt);
     }
     Interaction { forces, dt_limit }
 }
@@ -202,6 +266,10 @@ mod tests {
     use super::super::Phase;
     use super::super::kernel::smoothing_length;
     use super::*;
+
+    fn sub3(a: &[f32; 4], b: &[f32; 4]) -> [f32; 3] {
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
 
     const WATER: usize = 0;
     const WALL: usize = 1;

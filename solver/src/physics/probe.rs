@@ -42,26 +42,38 @@ pub fn probe(
         vel_rho.len(),
         "positions and velocities differ in length"
     );
-    let h = params.h;
-    let support2 = 4.0 * h * h;
     let mut sums = ProbeSums::default();
     for (x, v) in pos.iter().zip(vel_rho) {
-        let phase = &params.phases[phase_index(x)];
-        if !phase.mobile {
-            continue;
-        }
-        let d = [point[0] - x[0], point[1] - x[1], point[2] - x[2]];
-        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        if r2 >= support2 {
-            continue;
-        }
-        let rho = v[3];
-        let vw = phase.mass / rho * w(r2.sqrt(), h, params.dim);
-        sums.fullness += vw;
-        sums.phase_fullness[phase_index(x)] += vw;
-        sums.pressure_sum += vw * pressure(rho, phase.rho0, tait_b(params.c0, phase.rho0));
+        add_particle(params, point, x, v, &mut sums);
     }
     sums
+}
+
+/// Adds particle `x`, `v` to the kernel sums at `point`: nothing from a wall or from beyond
+/// the support 2h.
+pub fn add_particle(
+    params: &Params,
+    point: [f32; 3],
+    x: &[f32; 4],
+    v: &[f32; 4],
+    sums: &mut ProbeSums,
+) {
+    let k = phase_index(x);
+    let phase = &params.phases[k];
+    if !phase.mobile {
+        return;
+    }
+    let h = params.h;
+    let d = [point[0] - x[0], point[1] - x[1], point[2] - x[2]];
+    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if r2 >= 4.0 * h * h {
+        return;
+    }
+    let rho = v[3];
+    let vw = phase.mass / rho * w(r2.sqrt(), h, params.dim);
+    sums.fullness += vw;
+    sums.phase_fullness[k] += vw;
+    sums.pressure_sum += vw * pressure(rho, phase.rho0, tait_b(params.c0, phase.rho0));
 }
 
 /// Water level on a vertical line sampled at ascending `heights` with kernel `fullness` values.

@@ -2,7 +2,9 @@
 
 #![allow(dead_code)]
 
-use flume_solver::GpuContext;
+pub mod stages;
+
+use flume_solver::{Backend, GpuContext};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 /// GPU tests run one at a time: lavapipe already uses every core.
@@ -153,9 +155,9 @@ pub fn perturbed(
 }
 
 /// A simulation of `case` started from its lattice perturbed as `perturbed` does, with that
-/// state and the CPU oracle's parameters: the starting point of every GPU-vs-CPU test.
+/// state and the CPU oracle's parameters: the starting point of every stage-vs-oracle test.
 pub fn perturbed_sim(
-    gpu: &Arc<GpuContext>,
+    backend: impl Into<Backend>,
     case: &flume_solver::Case,
     speed: f32,
     seed: u64,
@@ -164,9 +166,10 @@ pub fn perturbed_sim(
     flume_solver::case::Particles,
     flume_solver::physics::Params,
 ) {
-    let lattice = flume_solver::Simulation::new(Arc::clone(gpu), case).expect("case builds");
+    let backend = backend.into();
+    let lattice = flume_solver::Simulation::new(backend.clone(), case).expect("case builds");
     let particles = perturbed(&lattice, speed, seed);
-    let sim = flume_solver::Simulation::from_particles(Arc::clone(gpu), case, particles.clone())
+    let sim = flume_solver::Simulation::from_particles(backend, case, particles.clone())
         .expect("perturbed state builds");
     let params = reference_params(&sim);
     (sim, particles, params)

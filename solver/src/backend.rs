@@ -1,0 +1,74 @@
+//! Which backend runs a case: a real GPU through wgpu when one is present, else the native CPU
+//! backend; `FLUME_TWIN_ADAPTER` forces either (`cpu`, or any part of an adapter's name, such
+//! as `llvmpipe` for lavapipe).
+
+use crate::config::Case;
+use crate::gpu::context::ADAPTER_ENV;
+use crate::gpu::{GpuContext, GpuError};
+use std::sync::Arc;
+
+/// The value of `FLUME_TWIN_ADAPTER` that picks the CPU backend.
+pub const CPU_BACKEND: &str = "cpu";
+
+#[derive(Clone)]
+pub enum Backend {
+    /// The wgpu backend on this adapter.
+    Gpu(Arc<GpuContext>),
+    /// The native CPU backend on this many threads (0: one per core).
+    Cpu { threads: usize },
+}
+
+impl From<Arc<GpuContext>> for Backend {
+    fn from(gpu: Arc<GpuContext>) -> Backend {
+        Backend::Gpu(gpu)
+    }
+}
+
+impl From<&Arc<GpuContext>> for Backend {
+    fn from(gpu: &Arc<GpuContext>) -> Backend {
+        Backend::Gpu(Arc::clone(gpu))
+    }
+}
+
+impl std::fmt::Debug for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe())
+    }
+}
+
+impl Backend {
+    /// The backend for `case`: the one `FLUME_TWIN_ADAPTER` names, else a real (not software)
+    /// GPU, else the CPU backend where it runs the case, else the best software adapter.
+    pub fn choose(case: &Case) -> Result<Backend, GpuError> {
+        let wanted = std::env::var(ADAPTER_ENV).ok().filter(|s| !s.is_empty());
+        match wanted.as_deref() {
+            Some(w) if w.eq_ignore_ascii_case(CPU_BACKEND) => Ok(Backend::Cpu { threads: 0 }),
+            Some(w) => Ok(Backend::Gpu(Arc::new(GpuContext::with_adapter(Some(w))?))),
+            None => Self::best(case),
+        }
+    }
+
+    fn best(case: &Case) -> Result<Backend, GpuError> {
+        let gpu = GpuContext::with_adapter(None);
+        if let Ok(g) = &gpu
+            && !g.is_software()
+        {
+            return gpu.map(|g| Backend::Gpu(Arc::new(g)));
+        }
+        match crate::cpu::unsupported(case) {
+            None => Ok(Backend::Cpu { threads: 0 }),
+            Some(why) => {
+                log::info!("the CPU backend {why}: running on a wgpu adapter");
+                gpu.map(|g| Backend::Gpu(Arc::new(g)))
+            }
+        }
+    }
+
+    /// A line naming the backend and its device.
+    pub fn describe(&self) -> String {
+        match self {
+            Backend::Gpu(g) => format!("wgpu on {}", g.adapter),
+            Backend::Cpu { threads } => crate::cpu::describe(*threads),
+        }
+    }
+}

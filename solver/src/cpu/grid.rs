@@ -1,0 +1,105 @@
+//! The cell list of the CPU backend: the grid of `grid.wgsl` (cells of 2h / R numbered x
+//! fastest, so the R-neighbourhood of a cell is a few contiguous rows of the sorted arrays, as
+//! DualSPHysics' `ParticleRange`), a counting sort by cell and, inside each cell, by id.
+//! Sorting inside cells by id makes the order, and with it every neighbour sum, a function of
+//! the state alone: runs are bit-identical whatever came before and on any number of threads.
+
+use crate::gpu::params::SimParams;
+use std::ops::Range;
+
+pub struct Grid {
+    dims: [i32; 3],
+    origin: [f32; 3],
+    inv_cell: f32,
+    /// Cells each way the kernel support reaches (cell divisions R).
+    reach: i32,
+    /// Sorted index of each cell's first particle; `n_cells + 1` entries.
+    pub starts: Vec<u32>,
+}
+
+impl Grid {
+    pub fn new(params: &SimParams, divisions: u32) -> Grid {
+        let d = params.grid_dims;
+        let o = params.grid_origin;
+        Grid {
+            dims: [d[0] as i32, d[1] as i32, d[2] as i32],
+            origin: [o[0], o[1], o[2]],
+            inv_cell: o[3],
+            reach: divisions as i32,
+            starts: vec![0; params.n_cells as usize + 1],
+        }
+    }
+
+    /// The cell of a point, as `cell_coords` in grid.wgsl computes it: points outside the
+    /// grid are kept in its border cells.
+    pub fn coords(&self, x: &[f32; 3]) -> [i32; 3] {
+        let mut c = [0; 3];
+        for k in 0..3 {
+            let hi = (self.dims[k] - 1) as f32;
+            // NaN falls to cell 0, where the health check will have it.
+            c[k] = ((x[k] - self.origin[k]) * self.inv_cell)
+                .floor()
+                .clamp(0.0, hi) as i32;
+        }
+        c
+    }
+
+    fn index(&self, c: [i32; 3]) -> usize {
+        ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize
+    }
+
+    /// Sorts particles by (cell, id): returns, for each sorted slot, the storage index of its
+    /// particle, and fills `starts`.
+    pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32]) -> Vec<u32> {
+        let cells: Vec<u32> = positions
+            .iter()
+            .map(|p| self.index(self.coords(&[p[0], p[1], p[2]])) as u32)
+            .collect();
+        self.starts.fill(0);
+        for &c in &cells {
+            self.starts[c as usize + 1] += 1;
+        }
+        for c in 1..self.starts.len() {
+            self.starts[c] += self.starts[c - 1];
+        }
+        let mut cursor = self.starts.clone();
+        let mut order = vec![0u32; positions.len()];
+        for (i, &c) in cells.iter().enumerate() {
+            order[cursor[c as usize] as usize] = i as u32;
+            cursor[c as usize] += 1;
+        }
+        for c in 0..self.starts.len() - 1 {
+            let cell = &mut order[self.starts[c] as usize..self.starts[c + 1] as usize];
+            if cell.len() > 1 {
+                cell.sort_unstable_by_key(|&i| ids[i as usize]);
+            }
+        }
+        order
+    }
+
+    /// Calls `visit` with the sorted-index range of each row of cells within reach of cell
+    /// `c`, as `stencil_row` in neighbours.wgsl: (2R + 1) rows in 2-D, (2R + 1)^2 in 3-D.
+    #[inline]
+    pub fn rows(&self, c: [i32; 3], mut visit: impl FnMut(Range<usize>)) {
+        let r = self.reach;
+        // In 2-D the grid is one cell deep: the one plane z = 0.
+        let (z_lo, z_hi) = ((c[2] - r).max(0), (c[2] + r).min(self.dims[2] - 1));
+        let x0 = (c[0] - r).max(0);
+        let x1 = (c[0] + r).min(self.dims[0] - 1);
+        for z in z_lo..=z_hi {
+            for y in (c[1] - r).max(0)..=(c[1] + r).min(self.dims[1] - 1) {
+                let base = self.index([0, y, z]);
+                let lo = self.starts[base + x0 as usize] as usize;
+                let hi = self.starts[base + x1 as usize + 1] as usize;
+                if hi > lo {
+                    visit(lo..hi);
+                }
+            }
+        }
+    }
+}
+
+/// `values` in sorted order: slot k holds the value of storage index `order[k]`.
+pub fn gather<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
+    order.iter().map(|&i| values[i as usize]).collect()
+}

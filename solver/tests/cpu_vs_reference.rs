@@ -1,0 +1,54 @@
+//! Each stage of the CPU backend against its oracle in `flume_solver::physics`: the checks the
+//! wgpu stages pass on lavapipe (`common/stages.rs`), with the same tolerances.
+
+mod common;
+
+use common::stages::{self, case};
+use flume_solver::Backend;
+
+const CPU: Backend = Backend::Cpu { threads: 2 };
+
+#[test]
+fn cell_list_matches_a_counting_sort_exactly() {
+    stages::check_cell_list(&CPU);
+}
+
+#[test]
+fn forces_match_the_interaction_2d() {
+    stages::check_forces(&CPU, case("tests/cases/hydrostatic_2d.yaml"), "2-D", 7);
+}
+
+#[test]
+fn forces_match_the_interaction_3d() {
+    stages::check_forces(&CPU, case("tests/cases/hydrostatic_3d.yaml"), "3-D", 8);
+}
+
+#[test]
+fn forces_with_molteni_diffusion_match_the_interaction() {
+    stages::check_forces(&CPU, stages::molteni_case(), "Molteni-Colagrossi", 19);
+}
+
+#[test]
+fn laminar_forces_match_the_interaction() {
+    stages::check_laminar_forces(&CPU);
+}
+
+#[test]
+fn one_symplectic_step_matches_the_oracle() {
+    stages::check_symplectic_step(&CPU);
+}
+
+#[test]
+fn two_verlet_steps_match_the_oracle() {
+    stages::check_verlet_steps(&CPU);
+}
+
+#[test]
+fn probes_and_extremes_match_the_oracle() {
+    stages::check_probes(&CPU);
+}
+
+#[test]
+fn probe_phase_fullness_matches_the_oracle() {
+    stages::check_phase_fullness(&CPU);
+}
