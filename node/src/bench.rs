@@ -1,12 +1,14 @@
 //! `flume-twin bench`: throughput (particle-steps/s) and real-time factor on this machine.
 //!
 //! Each measurement warms up, estimates the cost of a step, then times whole steps for about
-//! `--steps-seconds` of wall time. Nothing here asserts on speed: the figures are for a log.
+//! `--steps-seconds` of wall time, on each backend side by side (the native CPU backend and the
+//! wgpu adapter). Nothing here asserts on speed: the figures are for a log.
 
 use crate::cli::BenchArgs;
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
-use flume_solver::{Case, GpuContext, Simulation};
+use flume_solver::engine::StageTime;
+use flume_solver::{Backend, Case, GpuContext, Simulation, SolverError};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -30,6 +32,10 @@ struct Measurement {
     /// Simulated time covered by the timed stretch, from `start_s`.
     sim_s: f64,
     start_s: f64,
+    /// The backend, as it names itself.
+    backend: String,
+    /// Seconds per stage over the timed stretch; empty where the backend cannot time them.
+    stages: Vec<StageTime>,
 }
 
 impl Measurement {
@@ -59,8 +65,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .context("cannot load the reference case (run from the repository root or pass --case)")?;
     let flume = Case::from_path(&args.flume)
         .context("cannot load the flume case (run from the repository root or pass --flume)")?;
-    let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
-    println!("adapter: {}", gpu.adapter);
+    let backends = backends()?;
+    for b in &backends {
+        println!("backend: {}", b.describe());
+    }
     println!(
         "each figure times whole steps for about {} s of wall time, after a warm-up",
         args.steps_seconds
@@ -76,13 +84,16 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut table = throughput_table();
     let mut errors = Vec::new();
     for &n in &args.ladder {
-        let result = dam_break_case(n).and_then(|case| measure(&gpu, &case, args.steps_seconds));
-        match result {
-            Ok(m) => throughput_row(&mut table, &m, &gpu.adapter.name),
-            Err(e) => {
-                failures += 1;
-                table.row([format!("~{n}"), "failed".to_string()]);
-                errors.push(format!("~{n} particles: {e:#}"));
+        for b in &backends {
+            let result = dam_break_case(n).and_then(|case| measure(b, &case, args.steps_seconds));
+            match result {
+                Ok(Some(m)) => throughput_row(&mut table, &m),
+                Ok(None) => {}
+                Err(e) => {
+                    failures += 1;
+                    table.row([format!("~{n}"), "failed".to_string()]);
+                    errors.push(format!("~{n} particles: {e:#}"));
+                }
             }
         }
     }
@@ -93,13 +104,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
     println!();
     println!("case {} ({})", reference.name, args.case.display());
-    match measure(&gpu, &reference, args.steps_seconds) {
-        Ok(m) => print_reference(&m, &reference, &gpu.adapter.name),
-        Err(e) => {
-            failures += 1;
-            println!("error: {e:#}");
+    let mut measured = Vec::new();
+    for b in &backends {
+        match measure(b, &reference, args.steps_seconds) {
+            Ok(m) => measured.extend(m),
+            Err(e) => {
+                failures += 1;
+                println!("error: {e:#}");
+            }
         }
     }
+    print_reference(&measured, &reference);
     println!();
     println!(
         "open flume {} ({}), dp = {} m, from the dry start with the inlet running;\n\
@@ -108,21 +123,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         args.flume.display(),
         flume.numerics.dp_m
     );
-    match measure(&gpu, &flume, args.steps_seconds) {
-        Ok(m) => {
-            let mut table = throughput_table();
-            throughput_row(&mut table, &m, &gpu.adapter.name);
-            print!("{table}");
-            println!(
-                "real-time factor: {} simulated s per wall s (t = {:.4} .. {:.4} s)",
-                sig(m.sim_s / m.wall_s),
-                m.start_s,
-                m.start_s + m.sim_s
-            );
-        }
-        Err(e) => {
-            failures += 1;
-            println!("error: {e:#}");
+    for b in &backends {
+        match measure(b, &flume, args.steps_seconds) {
+            Ok(Some(m)) => {
+                let mut table = throughput_table();
+                throughput_row(&mut table, &m);
+                print!("{table}");
+                println!(
+                    "real-time factor: {} simulated s per wall s (t = {:.4} .. {:.4} s)",
+                    sig(m.sim_s / m.wall_s),
+                    m.start_s,
+                    m.start_s + m.sim_s
+                );
+                print_stages(&m);
+            }
+            Ok(None) => {}
+            Err(e) => {
+                failures += 1;
+                println!("error: {e:#}");
+            }
         }
     }
     if failures > 0 {
@@ -134,34 +153,72 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-fn print_reference(m: &Measurement, case: &Case, adapter: &str) {
+/// The backends to time: the CPU backend, and the wgpu adapter when there is one, unless
+/// `FLUME_TWIN_ADAPTER` names one of them.
+fn backends() -> Result<Vec<Backend>> {
+    let wanted = std::env::var(flume_solver::gpu::context::ADAPTER_ENV).unwrap_or_default();
+    if wanted.eq_ignore_ascii_case(flume_solver::backend::CPU_BACKEND) {
+        return Ok(vec![Backend::Cpu { threads: 0 }]);
+    }
+    if !wanted.is_empty() {
+        let gpu = GpuContext::new().context("cannot open the adapter FLUME_TWIN_ADAPTER names")?;
+        return Ok(vec![Backend::from(Arc::new(gpu))]);
+    }
+    let mut out = vec![Backend::Cpu { threads: 0 }];
+    match GpuContext::new() {
+        Ok(gpu) => out.push(Backend::from(Arc::new(gpu))),
+        Err(e) => println!("no wgpu adapter: {e}"),
+    }
+    Ok(out)
+}
+
+fn print_reference(measured: &[Measurement], case: &Case) {
     let mut table = throughput_table();
-    throughput_row(&mut table, m, adapter);
+    for m in measured {
+        throughput_row(&mut table, m);
+    }
     print!("{table}");
-    let rate = m.particle_steps_per_s();
     println!("against DualSPHysics 5.4 on the CPU (2 OpenMP threads), same case:");
+    for m in measured {
+        let rate = m.particle_steps_per_s();
+        println!(
+            "  {}: Verlet ({}) ratio {:.3}, symplectic ({}) ratio {:.3}",
+            m.backend,
+            sci(DSPH_VERLET),
+            rate / DSPH_VERLET,
+            sci(DSPH_SYMPLECTIC),
+            rate / DSPH_SYMPLECTIC
+        );
+    }
     println!(
-        "  Verlet      {} particle-steps/s: ratio {:.3}",
-        sci(DSPH_VERLET),
-        rate / DSPH_VERLET
-    );
-    println!(
-        "  symplectic  {} particle-steps/s: ratio {:.3}",
-        sci(DSPH_SYMPLECTIC),
-        rate / DSPH_SYMPLECTIC
-    );
-    println!(
-        "  This run used the {:?} integrator: compare with the line of the same scheme (a\n  \
+        "  This run used the {:?} integrator: compare with the ratio of the same scheme (a\n  \
          Verlet step takes one force pass, a symplectic step two).",
         case.numerics.integrator
     );
-    println!(
-        "real-time factor: {} simulated s per wall s (t = {:.4} .. {:.4} s of the {} s case)",
-        sig(m.sim_s / m.wall_s),
-        m.start_s,
-        m.start_s + m.sim_s,
-        case.time.end_s
-    );
+    for m in measured {
+        println!(
+            "real-time factor on {}: {} simulated s per wall s (t = {:.4} .. {:.4} s of the {} s case)",
+            m.backend,
+            sig(m.sim_s / m.wall_s),
+            m.start_s,
+            m.start_s + m.sim_s,
+            case.time.end_s
+        );
+        print_stages(m);
+    }
+}
+
+/// Where the timed stretch's wall time went, stage by stage.
+fn print_stages(m: &Measurement) {
+    if m.stages.is_empty() {
+        return;
+    }
+    let parts: Vec<String> = m
+        .stages
+        .iter()
+        .map(|s| format!("{} {:.1} %", s.stage, 100.0 * s.seconds / m.wall_s))
+        .collect();
+    println!("  stages on {}: {}", m.backend, parts.join(", "));
 }
 
 fn throughput_table() -> Table {
@@ -172,12 +229,12 @@ fn throughput_table() -> Table {
         "wall s",
         "steps/s",
         "particle-steps/s",
-        "adapter",
+        "backend",
     ])
 }
 
 /// One row of a throughput table.
-fn throughput_row(table: &mut Table, m: &Measurement, adapter: &str) {
+fn throughput_row(table: &mut Table, m: &Measurement) {
     table.row([
         m.particles.to_string(),
         m.fluid.to_string(),
@@ -185,7 +242,7 @@ fn throughput_row(table: &mut Table, m: &Measurement, adapter: &str) {
         format!("{:.2}", m.wall_s),
         sig(m.steps_per_s()),
         sci(m.particle_steps_per_s()),
-        adapter.to_string(),
+        m.backend.clone(),
     ]);
 }
 
@@ -225,11 +282,18 @@ time: {{ end_s: 10.0, output_interval_s: 0.01 }}
         .with_context(|| format!("the synthetic case for {fluid} particles is invalid"))
 }
 
-/// Times `case` on `gpu` for about `wall_target_s` after a warm-up.
-fn measure(gpu: &Arc<GpuContext>, case: &Case, wall_target_s: f64) -> Result<Measurement> {
+/// Times `case` on `backend` for about `wall_target_s` after a warm-up; None (and a line
+/// saying why) where the backend does not run the case.
+fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Option<Measurement>> {
     let name = &case.name;
-    let mut sim =
-        Simulation::new(Arc::clone(gpu), case).with_context(|| format!("cannot set up {name}"))?;
+    let mut sim = match Simulation::new(backend.clone(), case) {
+        Ok(sim) => sim,
+        Err(SolverError::CpuUnsupported(why)) => {
+            println!("{name}: not timed on the CPU backend, which {why}");
+            return Ok(None);
+        }
+        Err(e) => return Err(e).with_context(|| format!("cannot set up {name}")),
+    };
     let derived = sim.derived();
     // The acoustic CFL limit: the real step is never larger, so the warm-up is at least 4 steps.
     let dt_guess = case.numerics.cfl * derived.h / derived.c0;
@@ -257,6 +321,7 @@ fn measure(gpu: &Arc<GpuContext>, case: &Case, wall_target_s: f64) -> Result<Mea
     // shrinks as the column collapses, so one stretch of the estimate could overshoot.
     let start_s = sim.time_s();
     let steps0 = sim.steps();
+    let stages0 = sim.stage_times();
     let started = Instant::now();
     while started.elapsed().as_secs_f64() < wall_target_s {
         let piece_s = (0.25 * wall_target_s / wall_per_sim).max(2.0 * min_stretch_s(&sim));
@@ -267,14 +332,25 @@ fn measure(gpu: &Arc<GpuContext>, case: &Case, wall_target_s: f64) -> Result<Mea
     let wall_s = started.elapsed().as_secs_f64();
     // Parked particles of an open flume wait out of the flow and cost almost nothing.
     let parked = sim.flume().map_or(0, |f| f.parked_particles as usize);
-    Ok(Measurement {
+    let stages = sim
+        .stage_times()
+        .into_iter()
+        .zip(stages0)
+        .map(|(now, before)| StageTime {
+            stage: now.stage,
+            seconds: now.seconds - before.seconds,
+        })
+        .collect();
+    Ok(Some(Measurement {
         particles: sim.particle_count() - parked,
         fluid: sim.fluid_count() - parked,
         steps: sim.steps() - steps0,
         wall_s,
         sim_s: sim.time_s() - start_s,
         start_s,
-    })
+        backend: sim.backend_name(),
+        stages,
+    }))
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //! order), so this file is the specification of what each pair contributes.
 
 use super::eos::{pressure, tait_b};
-use super::kernel::grad_factor;
+use super::kernel::Wendland;
 use super::{Params, Viscosity};
 
 /// Result of one force pass, one entry per particle.
@@ -48,15 +48,32 @@ fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
 }
 
 /// One particle as its pairs see it: position, velocity, density, the pressure of the momentum
-/// equation and its phase index.
+/// equation over rho^2 and its phase index.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Side {
     pub x: [f32; 3],
     pub v: [f32; 3],
     pub rho: f32,
-    pub p: f32,
-    pub phase: usize,
+    pub p_over_rho2: f32,
+    pub phase: u32,
 }
+
+/// What a pair needs of a phase, in a table of fixed size (phase indices are masked into it).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct PhaseConsts {
+    rho0: f32,
+    mass: f32,
+    mu: f32,
+    mobile: bool,
+    /// Tait's stiffness B.
+    b: f32,
+    /// `rho0 g / B`, 1/m: the argument of the hydrostatic density difference per metre of
+    /// height.
+    hydro: f32,
+}
+
+/// Slots of the phase table; a power of two, the GPU uniform's `MAX_PHASES`.
+const PHASE_SLOTS: usize = 4;
 
 /// The running sums of one particle's pair terms.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -73,12 +90,13 @@ pub struct PairSum {
 #[derive(Clone, Debug)]
 pub struct PairModel<'a> {
     params: &'a Params,
-    stiffness: Vec<f32>,
+    phases: [PhaseConsts; PHASE_SLOTS],
+    kernel: Wendland,
     support2: f32,
     coincident2: f32,
     eta2: f32,
-    /// Downward gravity (positive), for the hydrostatic density difference.
-    g: f32,
+    /// delta h c0 of the diffusion term, m2/s.
+    delta_h_c0: f32,
     vertical: usize,
 }
 
@@ -86,17 +104,26 @@ impl<'a> PairModel<'a> {
     pub fn new(params: &'a Params) -> PairModel<'a> {
         let h = params.h;
         let vertical = (params.dim - 1) as usize;
+        assert!(params.phases.len() <= PHASE_SLOTS, "more phases than slots");
+        let mut phases = [PhaseConsts::default(); PHASE_SLOTS];
+        for (slot, ph) in phases.iter_mut().zip(&params.phases) {
+            *slot = PhaseConsts {
+                rho0: ph.rho0,
+                mass: ph.mass,
+                mu: ph.mu,
+                mobile: ph.mobile,
+                b: tait_b(params.c0, ph.rho0),
+                hydro: ph.rho0 * -params.gravity[vertical] / tait_b(params.c0, ph.rho0),
+            };
+        }
         PairModel {
-            stiffness: params
-                .phases
-                .iter()
-                .map(|ph| tait_b(params.c0, ph.rho0))
-                .collect(),
+            phases,
+            kernel: Wendland::new(h, params.dim),
             support2: 4.0 * h * h,
             // Pairs closer than this are treated as coincident: x_ij carries no direction.
             coincident2: 1e-12 * h * h,
             eta2: 0.01 * h * h,
-            g: -params.gravity[vertical],
+            delta_h_c0: params.delta * h * params.c0,
             vertical,
             params,
         }
@@ -108,7 +135,8 @@ impl<'a> PairModel<'a> {
 
     /// The pressure of the momentum equation: Tait's, without tension when the case says so.
     pub fn pressure(&self, rho: f32, phase: usize) -> f32 {
-        let p = pressure(rho, self.params.phases[phase].rho0, self.stiffness[phase]);
+        let ph = self.phase(phase as u32);
+        let p = pressure(rho, ph.rho0, ph.b);
         if self.params.clamp_negative_pressure {
             p.max(0.0)
         } else {
@@ -119,13 +147,18 @@ impl<'a> PairModel<'a> {
     /// Particle `pos`, `vel_rho` as a pair sees it.
     pub fn side(&self, pos: &[f32; 4], vel_rho: &[f32; 4]) -> Side {
         let phase = phase_index(pos);
+        let rho = vel_rho[3];
         Side {
             x: [pos[0], pos[1], pos[2]],
             v: [vel_rho[0], vel_rho[1], vel_rho[2]],
-            rho: vel_rho[3],
-            p: self.pressure(vel_rho[3], phase),
-            phase,
+            rho,
+            p_over_rho2: self.pressure(rho, phase) / (rho * rho),
+            phase: phase as u32,
         }
+    }
+
+    fn phase(&self, k: u32) -> &PhaseConsts {
+        &self.phases[k as usize % PHASE_SLOTS]
     }
 
     /// Adds what neighbour `j` contributes to particle `i`'s density rate and acceleration:
@@ -138,18 +171,19 @@ impl<'a> PairModel<'a> {
             return;
         }
         let params = self.params;
-        let (phase_i, phase_j) = (&params.phases[i.phase], &params.phases[j.phase]);
+        let (phase_i, phase_j) = (self.phase(i.phase), self.phase(j.phase));
         // DBC as in DualSPHysics: a wall's density answers to the fluid only.
         if !phase_i.mobile && !phase_j.mobile {
             return;
         }
         let h = params.h;
-        let f = grad_factor(r2.sqrt(), h, params.dim);
-        let (m_j, rho_j) = if phase_i.mobile && !phase_j.mobile {
+        let f = self.kernel.grad_factor(r2.sqrt());
+        // A wall's pressure over rho^2 at the density it stands in for: p / (r rho)^2.
+        let (m_j, rho_j, p_j) = if phase_i.mobile && !phase_j.mobile {
             let r = wall_scale(phase_i.rho0, phase_j.rho0);
-            (phase_j.mass * r, j.rho * r)
+            (phase_j.mass * r, j.rho * r, j.p_over_rho2 / (r * r))
         } else {
-            (phase_j.mass, j.rho)
+            (phase_j.mass, j.rho, j.p_over_rho2)
         };
         let v_ij = [i.v[0] - j.v[0], i.v[1] - j.v[1], i.v[2] - j.v[2]];
         let vdotr = dot3(v_ij, x_ij);
@@ -159,11 +193,10 @@ impl<'a> PairModel<'a> {
             return;
         }
         if params.delta > 0.0 && phase_j.mobile && j.phase == i.phase {
-            sum.drho +=
-                params.delta * h * params.c0 * self.diffusion(i, j, rho_j, r2, f) * (m_j / rho_j);
+            sum.drho += self.delta_h_c0 * self.diffusion(i, j, rho_j, r2, f) * (m_j / rho_j);
         }
         // Pressure gradient, Eq. 10 with sigma = -p I.
-        let mut coef = -m_j * (i.p / (i.rho * i.rho) + j.p / (rho_j * rho_j));
+        let mut coef = -m_j * (i.p_over_rho2 + p_j);
         let mu_ij = h * vdotr / (r2 + self.eta2);
         sum.visc_max = sum.visc_max.max(mu_ij.abs());
         match params.viscosity {
@@ -194,9 +227,9 @@ impl<'a> PairModel<'a> {
     /// series: x is below 1e-3 for neighbours (dz < 2h), where three terms are exact in f32.
     fn diffusion(&self, i: &Side, j: &Side, rho_j: f32, r2: f32, f: f32) -> f32 {
         let rho_h = if self.params.hydrostatic_diffusion {
-            let rho0 = self.params.phases[i.phase].rho0;
-            let dz = i.x[self.vertical] - j.x[self.vertical];
-            let x = rho0 * self.g * dz / self.stiffness[i.phase];
+            let phase = self.phase(i.phase);
+            let rho0 = phase.rho0;
+            let x = phase.hydro * (i.x[self.vertical] - j.x[self.vertical]);
             rho0 * x * (1.0 / 7.0 + x * (-3.0 / 49.0 + x * (13.0 / 343.0)))
         } else {
             0.0
@@ -210,7 +243,7 @@ impl<'a> PairModel<'a> {
     /// acceleration does not bound the step.
     pub fn finish(&self, i: &Side, sum: &PairSum, force_bound: bool) -> ([f32; 4], f32) {
         let params = self.params;
-        if !params.phases[i.phase].mobile {
+        if !self.phase(i.phase).mobile {
             return ([0.0, 0.0, 0.0, sum.drho], f32::INFINITY);
         }
         let mut acc = sum.acc;
@@ -264,7 +297,7 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
 #[cfg(test)]
 mod tests {
     use super::super::Phase;
-    use super::super::kernel::smoothing_length;
+    use super::super::kernel::{grad_factor, smoothing_length};
     use super::*;
 
     fn sub3(a: &[f32; 4], b: &[f32; 4]) -> [f32; 3] {

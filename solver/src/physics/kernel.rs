@@ -32,12 +32,36 @@ pub fn w(r: f32, h: f32, dim: u32) -> f32 {
 /// Dividing dW/dr by r analytically removes the 0/0 at r = 0, so F stays finite for coincident
 /// particles (F(0) = -5 a_d / h^2).
 pub fn grad_factor(r: f32, h: f32, dim: u32) -> f32 {
-    let q = r / h;
-    if q < 2.0 {
-        let t = 1.0 - 0.5 * q;
-        alpha_d(dim, h) * (-5.0 / (h * h)) * (t * t * t)
-    } else {
-        0.0
+    Wendland::new(h, dim).grad_factor(r)
+}
+
+/// The kernel's gradient with its constants worked out once for a smoothing length: a
+/// neighbour loop calls it for every pair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wendland {
+    inv_h: f32,
+    /// `-5 a_d / h^2`.
+    grad_coef: f32,
+}
+
+impl Wendland {
+    pub fn new(h: f32, dim: u32) -> Wendland {
+        Wendland {
+            inv_h: 1.0 / h,
+            grad_coef: alpha_d(dim, h) * (-5.0 / (h * h)),
+        }
+    }
+
+    /// F of [`grad_factor`].
+    #[inline]
+    pub fn grad_factor(&self, r: f32) -> f32 {
+        let q = r * self.inv_h;
+        if q < 2.0 {
+            let t = 1.0 - 0.5 * q;
+            self.grad_coef * (t * t * t)
+        } else {
+            0.0
+        }
     }
 }
 
