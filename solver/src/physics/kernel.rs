@@ -17,14 +17,7 @@ pub fn alpha_d(dim: u32, h: f32) -> f32 {
 
 /// Kernel value W(r, h), 1/m^dim.
 pub fn w(r: f32, h: f32, dim: u32) -> f32 {
-    let q = r / h;
-    if q < 2.0 {
-        let t = 1.0 - 0.5 * q;
-        let t2 = t * t;
-        alpha_d(dim, h) * t2 * t2 * (2.0 * q + 1.0)
-    } else {
-        0.0
-    }
+    Wendland::new(h, dim).w(r)
 }
 
 /// Factor F with `grad_i W_ij = (x_i - x_j) F`, i.e. `F = (dW/dr) / r`.
@@ -40,6 +33,7 @@ pub fn grad_factor(r: f32, h: f32, dim: u32) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wendland {
     inv_h: f32,
+    ad: f32,
     /// `-5 a_d / h^2`.
     grad_coef: f32,
 }
@@ -48,7 +42,21 @@ impl Wendland {
     pub fn new(h: f32, dim: u32) -> Wendland {
         Wendland {
             inv_h: 1.0 / h,
+            ad: alpha_d(dim, h),
             grad_coef: alpha_d(dim, h) * (-5.0 / (h * h)),
+        }
+    }
+
+    /// W of [`w`].
+    #[inline]
+    pub fn w(&self, r: f32) -> f32 {
+        let q = r * self.inv_h;
+        if q < 2.0 {
+            let t = 1.0 - 0.5 * q;
+            let t2 = t * t;
+            self.ad * t2 * t2 * (2.0 * q + 1.0)
+        } else {
+            0.0
         }
     }
 

@@ -49,30 +49,48 @@ use super::suspension::Region;
 use crate::physics::Params;
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::phase_index;
-use crate::physics::kernel::w;
+use crate::physics::kernel::Wendland;
 
 /// Shepard average `sum_j weight_j tau_j / sum_j weight_j` of the stresses of the moving
 /// neighbours, Pa; `None` when no weight is positive (nothing moves next to the particle).
 pub fn transmitted_stress(weights: &[f32], stresses: &[Tensor3]) -> Option<Tensor3> {
     assert_eq!(weights.len(), stresses.len(), "weights and stresses differ");
-    let total: f32 = weights.iter().sum();
-    if total.is_nan() || total <= 0.0 {
-        return None;
+    let mut sums = Transmitted::default();
+    for (&w, t) in weights.iter().zip(stresses) {
+        sums.add(w, t);
     }
-    let mut tau = [[0.0_f32; 3]; 3];
-    for (&wj, t) in weights.iter().zip(stresses) {
+    sums.mean()
+}
+
+/// The running sums of [`transmitted_stress`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Transmitted {
+    weight: f32,
+    tau: Tensor3,
+}
+
+impl Transmitted {
+    pub fn add(&mut self, weight: f32, tau: &Tensor3) {
+        self.weight += weight;
         for a in 0..3 {
             for b in 0..3 {
-                tau[a][b] += wj * t[a][b];
+                self.tau[a][b] += weight * tau[a][b];
             }
         }
     }
-    for row in &mut tau {
-        for x in row {
-            *x /= total;
+
+    pub fn mean(&self) -> Option<Tensor3> {
+        if self.weight.is_nan() || self.weight <= 0.0 {
+            return None;
         }
+        let mut tau = self.tau;
+        for row in &mut tau {
+            for x in row {
+                *x /= self.weight;
+            }
+        }
+        Some(tau)
     }
-    Some(tau)
 }
 
 /// The stress invariant at which Eq. 15 (as written) lets sediment of yield stress tau_y flow,
@@ -83,6 +101,73 @@ pub const FLOW_ONSET: f32 = 2.0;
 /// `tau`: its invariant `sqrt(J2)` exceeds `FLOW_ONSET tau_y` (Eq. 30 with Eq. 15's onset).
 pub fn released(tau: &Tensor3, tau_y: f32) -> bool {
     yields(second_invariant(tau).sqrt(), FLOW_ONSET * tau_y)
+}
+
+/// The release stage of one run: [`Release::add_pair`] and [`Release::released`] are the one
+/// statement of it, which the brute-force [`release_pass`] and the CPU backend both call.
+#[derive(Clone, Debug)]
+pub struct Release<'a> {
+    model: &'a SedimentModel,
+    kernel: Wendland,
+    support2: f32,
+    /// Mass, rest density and Tait stiffness of the sediment.
+    sediment: (f32, f32, f32),
+    alpha_dp: f32,
+    kappa_dp: f32,
+}
+
+impl<'a> Release<'a> {
+    pub fn new(params: &Params, model: &'a SedimentModel) -> Release<'a> {
+        let mat = &model.material;
+        let sed = &params.phases[model.sediment_phase];
+        Release {
+            model,
+            kernel: Wendland::new(params.h, params.dim),
+            support2: 4.0 * params.h * params.h,
+            sediment: (sed.mass, sed.rho0, tait_b(params.c0, sed.rho0)),
+            alpha_dp: alpha(mat.phi_rad),
+            kappa_dp: kappa_c(mat.phi_rad, mat.cohesion_pa),
+        }
+    }
+
+    /// Whether the release decides on particle `x` of this rheology: held sediment.
+    pub fn applies(&self, x: &[f32; 4], rheology: &ParticleRheology) -> bool {
+        !self.model.shields_only
+            && rheology.held
+            && phase_index(x) == self.model.sediment_phase
+    }
+
+    /// Adds neighbour j (position, velocity-density, rheology) to a held particle at `x_i`:
+    /// only moving sediment within the support counts.
+    #[inline]
+    pub fn add_pair(
+        &self,
+        x_i: &[f32; 4],
+        (x_j, v_j, r_j): (&[f32; 4], &[f32; 4], &ParticleRheology),
+        sums: &mut Transmitted,
+    ) {
+        if r_j.held || phase_index(x_j) != self.model.sediment_phase {
+            return;
+        }
+        let r2: f32 = (0..3).map(|k| (x_i[k] - x_j[k]).powi(2)).sum();
+        if r2 < self.support2 {
+            let v = self.sediment.0 / v_j[3];
+            sums.add(v * self.kernel.w(r2.sqrt()), &r_j.stress);
+        }
+    }
+
+    /// Whether a held particle of density `rho_i` with these sums is released.
+    pub fn released(&self, rho_i: f32, sums: &Transmitted) -> bool {
+        let (_, rho0, b) = self.sediment;
+        let mat = &self.model.material;
+        let p = pressure(rho_i, rho0, b);
+        let tau_y = yield_stress(
+            self.alpha_dp,
+            self.kappa_dp,
+            skeleton_pressure(p, mat.rho_s, mat.rho_w),
+        );
+        sums.mean().is_some_and(|t| released(&t, tau_y))
+    }
 }
 
 /// Releases the held sediment that its moving neighbours make yield (see the module doc), in
@@ -100,34 +185,15 @@ pub fn release_pass(
 ) {
     assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
     assert_eq!(pos.len(), rheology.len(), "positions and rheology differ");
-    if model.shields_only {
-        return;
-    }
-    let mat = &model.material;
-    let (alpha_dp, kappa_dp) = (alpha(mat.phi_rad), kappa_c(mat.phi_rad, mat.cohesion_pa));
-    let sed = &params.phases[model.sediment_phase];
-    let b = tait_b(params.c0, sed.rho0);
-    let support2 = 4.0 * params.h * params.h;
-    let is_sediment = |k: usize| phase_index(&pos[k]) == model.sediment_phase;
+    let stage = Release::new(params, model);
     let release: Vec<usize> = (0..pos.len())
-        .filter(|&i| rheology[i].held && is_sediment(i))
+        .filter(|&i| stage.applies(&pos[i], &rheology[i]))
         .filter(|&i| {
-            let (mut weights, mut stresses) = (Vec::new(), Vec::new());
-            for j in (0..pos.len()).filter(|&j| j != i && is_sediment(j) && !rheology[j].held) {
-                let r2: f32 = (0..3).map(|k| (pos[i][k] - pos[j][k]).powi(2)).sum();
-                if r2 < support2 {
-                    let v_j = sed.mass / vel_rho[j][3];
-                    weights.push(v_j * w(r2.sqrt(), params.h, params.dim));
-                    stresses.push(rheology[j].stress);
-                }
+            let mut sums = Transmitted::default();
+            for j in 0..pos.len() {
+                stage.add_pair(&pos[i], (&pos[j], &vel_rho[j], &rheology[j]), &mut sums);
             }
-            let p = pressure(vel_rho[i][3], sed.rho0, b);
-            let tau_y = yield_stress(
-                alpha_dp,
-                kappa_dp,
-                skeleton_pressure(p, mat.rho_s, mat.rho_w),
-            );
-            transmitted_stress(&weights, &stresses).is_some_and(|t| released(&t, tau_y))
+            stage.released(vel_rho[i][3], &sums)
         })
         .collect();
     for i in release {

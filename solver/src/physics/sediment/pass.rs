@@ -25,7 +25,7 @@ use super::suspension::{
 use crate::physics::Params;
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::{phase_index, wall_scale};
-use crate::physics::kernel::{grad_factor, w};
+use crate::physics::kernel::Wendland;
 
 /// The sediment model of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,15 +58,18 @@ pub struct ParticleRheology {
     pub held: bool,
 }
 
-/// Sums one sediment particle gathers from its neighbours.
-#[derive(Default)]
-struct Gathered {
+/// Sums a particle gathers from its neighbours in the rheology pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RheologySums {
+    /// `grad[a][b] = sum_j V_j (u_j - u_i)_a (grad_i W_ij)_b` (Eq. 13).
+    grad: Tensor3,
     sediment_volume: f32,
     mixture_volume: f32,
     kernel_mass: f32,
     /// `sum_water V_j grad_i W_ij`: points from the sediment into the water.
     normal: [f32; 3],
-    nearest_water: Option<(f32, usize)>,
+    /// Distance to the nearest water particle and its velocity relative to this one.
+    nearest_water: Option<(f32, [f32; 3])>,
 }
 
 /// Skeleton pressure p of Eq. 31, Pa, from the sediment particle's pressure `p` (its Tait
@@ -133,6 +136,199 @@ fn norm3(a: [f32; 3]) -> f32 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
+/// The rheology pass of one run, with its constants worked out once: [`Rheology::add_pair`]
+/// and [`Rheology::finish`] are the one statement of the pass, which the brute-force
+/// [`rheology_pass`] and the CPU backend's cell-list loop both call.
+#[derive(Clone, Debug)]
+pub struct Rheology<'a> {
+    params: &'a Params,
+    model: &'a SedimentModel,
+    kernel: Wendland,
+    support2: f32,
+    coincident2: f32,
+    /// Downward gravity, m/s2.
+    g: f32,
+    alpha_dp: f32,
+    kappa_dp: f32,
+    /// Kernel mass below which a sediment particle is at the bed surface (Eq. 26).
+    reference_mass: f32,
+    /// Tait's stiffness of the sediment.
+    b_sed: f32,
+}
+
+impl<'a> Rheology<'a> {
+    pub fn new(params: &'a Params, model: &'a SedimentModel) -> Rheology<'a> {
+        let h = params.h;
+        let mat = &model.material;
+        let sed = &params.phases[model.sediment_phase];
+        Rheology {
+            kernel: Wendland::new(h, params.dim),
+            support2: 4.0 * h * h,
+            coincident2: 1e-12 * h * h,
+            g: -params.gravity[(params.dim - 1) as usize],
+            alpha_dp: alpha(mat.phi_rad),
+            kappa_dp: kappa_c(mat.phi_rad, mat.cohesion_pa),
+            reference_mass: mat.surface_mass_fraction * sed.mass,
+            b_sed: tait_b(params.c0, sed.rho0),
+            params,
+            model,
+        }
+    }
+
+    fn is_sediment(&self, pos: &[f32; 4]) -> bool {
+        phase_index(pos) == self.model.sediment_phase
+    }
+
+    /// The sums particle `x_i`, `v_i` starts from: a sediment particle counts itself.
+    pub fn start(&self, x_i: &[f32; 4], v_i: &[f32; 4]) -> RheologySums {
+        let mut s = RheologySums::default();
+        if self.is_sediment(x_i) {
+            let mass = self.params.phases[self.model.sediment_phase].mass;
+            let vol = mass / v_i[3];
+            s.sediment_volume = vol;
+            s.mixture_volume = vol;
+            s.kernel_mass = mass * self.kernel.w(0.0) * vol;
+        }
+        s
+    }
+
+    /// Adds neighbour j to particle i's sums: nothing beyond the support or for a coincident
+    /// pair.
+    #[inline]
+    pub fn add_pair(
+        &self,
+        (x_i, v_i): (&[f32; 4], &[f32; 4]),
+        (x_j, v_j): (&[f32; 4], &[f32; 4]),
+        s: &mut RheologySums,
+    ) {
+        let x_ij = sub3(x_i, x_j);
+        let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
+        if r2 >= self.support2 || r2 < self.coincident2 {
+            return;
+        }
+        let pj = phase_index(x_j);
+        let m_j = self.params.phases[pj].mass;
+        let vol_j = m_j / v_j[3];
+        let r = r2.sqrt();
+        let f = self.kernel.grad_factor(r);
+        let du = sub3(v_j, v_i);
+        for a in 0..3 {
+            for b in 0..3 {
+                s.grad[a][b] += vol_j * du[a] * x_ij[b] * f;
+            }
+        }
+        let model = self.model;
+        if !self.is_sediment(x_i) || (pj != model.sediment_phase && pj != model.water_phase) {
+            return;
+        }
+        s.mixture_volume += vol_j;
+        if pj == model.sediment_phase {
+            s.sediment_volume += vol_j;
+            s.kernel_mass += m_j * self.kernel.w(r) * vol_j;
+        } else {
+            for (k, n) in s.normal.iter_mut().enumerate() {
+                *n += vol_j * f * x_ij[k];
+            }
+            if s.nearest_water.is_none_or(|(rn, _)| r < rn) {
+                s.nearest_water = Some((r, du));
+            }
+        }
+    }
+
+    /// Particle i's rheology from its sums, `held_before` whether it was held after the
+    /// previous pass (see [`rheology_pass`]).
+    pub fn finish(
+        &self,
+        x_i: &[f32; 4],
+        v_i: &[f32; 4],
+        s: &RheologySums,
+        held_before: bool,
+    ) -> ParticleRheology {
+        let params = self.params;
+        let phase_i = &params.phases[phase_index(x_i)];
+        if !phase_i.mobile {
+            return ParticleRheology {
+                stress: [[0.0; 3]; 3],
+                mu: 0.0,
+                region: 0,
+                held: false,
+            };
+        }
+        let eps = strain_rate(&s.grad, params.dim);
+        let ii_d = second_invariant(&eps);
+        let (region, mu, held) = if self.is_sediment(x_i) {
+            self.classify(v_i[3], s, ii_d, held_before)
+        } else {
+            (Region::Water as u32, phase_i.mu, false)
+        };
+        let mut stress = [[0.0_f32; 3]; 3];
+        // Shields-only holds carry no stress, as that mode always had; Drucker-Prager holds
+        // keep theirs (`super::hold`).
+        if !(held && self.model.shields_only) {
+            for a in 0..3 {
+                for b in 0..3 {
+                    stress[a][b] = 2.0 * mu * eps[a][b];
+                }
+            }
+        }
+        ParticleRheology {
+            stress,
+            mu,
+            region,
+            held,
+        }
+    }
+
+    /// Region, apparent viscosity and hold of a sediment particle of density `rho_i`.
+    fn classify(
+        &self,
+        rho_i: f32,
+        s: &RheologySums,
+        ii_d: f32,
+        held_before: bool,
+    ) -> (u32, f32, bool) {
+        let (model, mat) = (self.model, &self.model.material);
+        let sed = &self.params.phases[model.sediment_phase];
+        let p = pressure(rho_i, sed.rho0, self.b_sed);
+        let tau_y = yield_stress(
+            self.alpha_dp,
+            self.kappa_dp,
+            skeleton_pressure(p, mat.rho_s, mat.rho_w),
+        );
+        let at_surface = s.nearest_water.is_some() && s.kernel_mass < self.reference_mass;
+        let (tau_b, tau_bcr) = match s.nearest_water {
+            Some((z, u)) if at_surface => {
+                let u_star = friction_velocity(norm3(u), z, mat.ks_m(), mat.nu_w).u_star;
+                let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
+                let tau_bcr0 =
+                    critical_bed_shear_stress(theta, mat.rho_s, mat.rho_w, self.g, mat.d50_m);
+                let k = slope_factors(s.normal, u, self.params.dim, mat.phi_rad);
+                (
+                    bed_shear_stress(mat.rho_w, u_star),
+                    sloped_critical_stress(tau_bcr0, k, 1.0),
+                )
+            }
+            _ => (0.0, f32::INFINITY),
+        };
+        let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
+        let region = if model.shields_only {
+            classify_shields_only(at_surface, tau_b, tau_bcr, c_v)
+        } else if held_before && !(at_surface && tau_b > tau_bcr) {
+            Region::Unyielded
+        } else {
+            let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
+            let sqrt_j2 = 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt();
+            classify(true, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v)
+        };
+        let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
+        (
+            region as u32,
+            mu.min(model.mu_max),
+            region == Region::Unyielded,
+        )
+    }
+}
+
 /// The rheology of every particle (see the module doc), `held_before[i]` whether particle i was
 /// held after the previous pass. In the Drucker-Prager mode a particle held before stays held
 /// unless Shields makes it bed load: only [`super::hold::release_pass`], which follows this
@@ -149,179 +345,105 @@ pub fn rheology_pass(
 ) -> Vec<ParticleRheology> {
     assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
     assert_eq!(pos.len(), held_before.len(), "positions and holds differ");
-    let h = params.h;
-    let dim = params.dim;
-    let support2 = 4.0 * h * h;
-    let coincident2 = 1e-12 * h * h;
-    let g = -params.gravity[(dim - 1) as usize];
-    let mat = &model.material;
-    let alpha_dp = alpha(mat.phi_rad);
-    let kappa_dp = kappa_c(mat.phi_rad, mat.cohesion_pa);
-    let sed = &params.phases[model.sediment_phase];
-    let reference_mass = mat.surface_mass_fraction * sed.mass;
-    let in_mixture = |k: usize| k == model.sediment_phase || k == model.water_phase;
-
+    let pass = Rheology::new(params, model);
     (0..pos.len())
         .map(|i| {
-            let pi = phase_index(&pos[i]);
-            let phase_i = &params.phases[pi];
-            if !phase_i.mobile {
-                return ParticleRheology {
-                    stress: [[0.0; 3]; 3],
-                    mu: 0.0,
-                    region: 0,
-                    held: false,
-                };
-            }
-            let is_sediment = pi == model.sediment_phase;
-            let rho_i = vel_rho[i][3];
-            let mut grad = [[0.0_f32; 3]; 3];
-            let mut s = Gathered::default();
-            if is_sediment {
-                let v_i = sed.mass / rho_i;
-                s.sediment_volume = v_i;
-                s.mixture_volume = v_i;
-                s.kernel_mass = sed.mass * w(0.0, h, dim) * v_i;
-            }
+            let mut s = pass.start(&pos[i], &vel_rho[i]);
             for j in 0..pos.len() {
-                let x_ij = sub3(&pos[i], &pos[j]);
-                let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
-                if j == i || r2 >= support2 || r2 < coincident2 {
-                    continue;
-                }
-                let pj = phase_index(&pos[j]);
-                let m_j = params.phases[pj].mass;
-                let v_j = m_j / vel_rho[j][3];
-                let r = r2.sqrt();
-                let f = grad_factor(r, h, dim);
-                let du = sub3(&vel_rho[j], &vel_rho[i]);
-                for a in 0..3 {
-                    for b in 0..3 {
-                        grad[a][b] += v_j * du[a] * x_ij[b] * f;
-                    }
-                }
-                if !is_sediment || !in_mixture(pj) {
-                    continue;
-                }
-                s.mixture_volume += v_j;
-                if pj == model.sediment_phase {
-                    s.sediment_volume += v_j;
-                    s.kernel_mass += m_j * w(r, h, dim) * v_j;
-                } else {
-                    for (k, n) in s.normal.iter_mut().enumerate() {
-                        *n += v_j * f * x_ij[k];
-                    }
-                    if s.nearest_water.is_none_or(|(rn, _)| r < rn) {
-                        s.nearest_water = Some((r, j));
-                    }
-                }
+                pass.add_pair((&pos[i], &vel_rho[i]), (&pos[j], &vel_rho[j]), &mut s);
             }
-            let eps = strain_rate(&grad, dim);
-            let ii_d = second_invariant(&eps);
-            let (region, mu, held) = if is_sediment {
-                let p = pressure(rho_i, sed.rho0, tait_b(params.c0, sed.rho0));
-                let tau_y = yield_stress(
-                    alpha_dp,
-                    kappa_dp,
-                    skeleton_pressure(p, mat.rho_s, mat.rho_w),
-                );
-                let at_surface = s.nearest_water.is_some() && s.kernel_mass < reference_mass;
-                let (tau_b, tau_bcr) = match s.nearest_water {
-                    Some((z, j)) if at_surface => {
-                        let u = sub3(&vel_rho[j], &vel_rho[i]);
-                        let u_star = friction_velocity(norm3(u), z, mat.ks_m(), mat.nu_w).u_star;
-                        let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
-                        let tau_bcr0 =
-                            critical_bed_shear_stress(theta, mat.rho_s, mat.rho_w, g, mat.d50_m);
-                        let k = slope_factors(s.normal, u, dim, mat.phi_rad);
-                        (
-                            bed_shear_stress(mat.rho_w, u_star),
-                            sloped_critical_stress(tau_bcr0, k, 1.0),
-                        )
-                    }
-                    _ => (0.0, f32::INFINITY),
-                };
-                let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
-                let region = if model.shields_only {
-                    classify_shields_only(at_surface, tau_b, tau_bcr, c_v)
-                } else if held_before[i] && !(at_surface && tau_b > tau_bcr) {
-                    Region::Unyielded
-                } else {
-                    let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
-                    let sqrt_j2 = 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt();
-                    classify(true, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v)
-                };
-                let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
-                (
-                    region as u32,
-                    mu.min(model.mu_max),
-                    region == Region::Unyielded,
-                )
-            } else {
-                (Region::Water as u32, phase_i.mu, false)
-            };
-            let mut stress = [[0.0_f32; 3]; 3];
-            // Shields-only holds carry no stress, as that mode always had; Drucker-Prager holds
-            // keep theirs (`super::hold`).
-            if !(held && model.shields_only) {
-                for a in 0..3 {
-                    for b in 0..3 {
-                        stress[a][b] = 2.0 * mu * eps[a][b];
-                    }
-                }
-            }
-            ParticleRheology {
-                stress,
-                mu,
-                region,
-                held,
-            }
+            pass.finish(&pos[i], &vel_rho[i], &s, held_before[i])
         })
         .collect()
 }
 
-/// Viscous part of the momentum equation (Eq. 10 with sigma = -p I + tau):
-/// `sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij`, m/s2, for every mobile
-/// particle (zero for walls), with the stresses of [`rheology_pass`]; wall neighbours are
-/// scaled by [`wall_scale`] as in the pressure term.
+/// A particle as the stress divergence sees it: position, phase and `tau / rho^2`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StressSide {
+    pub x: [f32; 3],
+    pub phase: u32,
+    pub tau_over_rho2: Tensor3,
+}
+
+/// The viscous part of the momentum equation (Eq. 10 with sigma = -p I + tau), pair by pair:
+/// `sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij`, m/s2, for a mobile particle
+/// with the stresses of [`rheology_pass`]; a wall neighbour's mass is scaled by
+/// [`wall_scale`] as in the pressure term (its stress is zero).
+#[derive(Clone, Debug)]
+pub struct StressDivergence<'a> {
+    params: &'a Params,
+    kernel: Wendland,
+    support2: f32,
+    coincident2: f32,
+}
+
+impl<'a> StressDivergence<'a> {
+    pub fn new(params: &'a Params) -> StressDivergence<'a> {
+        let h = params.h;
+        StressDivergence {
+            params,
+            kernel: Wendland::new(h, params.dim),
+            support2: 4.0 * h * h,
+            coincident2: 1e-12 * h * h,
+        }
+    }
+
+    pub fn side(&self, x: &[f32; 4], rho: f32, stress: &Tensor3) -> StressSide {
+        let mut t = *stress;
+        for row in &mut t {
+            for v in row {
+                *v /= rho * rho;
+            }
+        }
+        StressSide {
+            x: [x[0], x[1], x[2]],
+            phase: phase_index(x) as u32,
+            tau_over_rho2: t,
+        }
+    }
+
+    /// Adds neighbour j's term to mobile particle i's acceleration `acc`.
+    #[inline]
+    pub fn add_pair(&self, i: &StressSide, j: &StressSide, acc: &mut [f32; 3]) {
+        let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
+        let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
+        if r2 >= self.support2 || r2 < self.coincident2 {
+            return;
+        }
+        let phases = &self.params.phases;
+        let phase_j = &phases[j.phase as usize];
+        let m_j = if phase_j.mobile {
+            phase_j.mass
+        } else {
+            phase_j.mass * wall_scale(phases[i.phase as usize].rho0, phase_j.rho0)
+        };
+        let f = self.kernel.grad_factor(r2.sqrt());
+        for a in 0..3 {
+            for b in 0..3 {
+                let t = i.tau_over_rho2[a][b] + j.tau_over_rho2[a][b];
+                acc[a] += m_j * t * x_ij[b] * f;
+            }
+        }
+    }
+}
+
+/// [`StressDivergence`] for every particle by brute force (zero for walls).
 pub fn stress_divergence(
     params: &Params,
     pos: &[[f32; 4]],
     vel_rho: &[[f32; 4]],
     rheology: &[ParticleRheology],
 ) -> Vec<[f32; 3]> {
-    let h = params.h;
-    let support2 = 4.0 * h * h;
-    let coincident2 = 1e-12 * h * h;
+    let div = StressDivergence::new(params);
+    let sides: Vec<StressSide> = (0..pos.len())
+        .map(|i| div.side(&pos[i], vel_rho[i][3], &rheology[i].stress))
+        .collect();
     (0..pos.len())
         .map(|i| {
             let mut acc = [0.0_f32; 3];
-            if !params.phases[phase_index(&pos[i])].mobile {
-                return acc;
-            }
-            let rho_i = vel_rho[i][3];
-            let t_i = &rheology[i].stress;
-            for j in 0..pos.len() {
-                let x_ij = sub3(&pos[i], &pos[j]);
-                let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
-                if j == i || r2 >= support2 || r2 < coincident2 {
-                    continue;
-                }
-                let phase_j = &params.phases[phase_index(&pos[j])];
-                let scale = if phase_j.mobile {
-                    1.0
-                } else {
-                    wall_scale(params.phases[phase_index(&pos[i])].rho0, phase_j.rho0)
-                };
-                let m_j = phase_j.mass * scale;
-                let rho_j = vel_rho[j][3] * scale;
-                let t_j = &rheology[j].stress;
-                let f = grad_factor(r2.sqrt(), h, params.dim);
-                for a in 0..3 {
-                    for b in 0..3 {
-                        let t = t_i[a][b] / (rho_i * rho_i) + t_j[a][b] / (rho_j * rho_j);
-                        acc[a] += m_j * t * x_ij[b] * f;
-                    }
+            if params.phases[phase_index(&pos[i])].mobile {
+                for j in &sides {
+                    div.add_pair(&sides[i], j, &mut acc);
                 }
             }
             acc
