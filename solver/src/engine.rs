@@ -41,7 +41,7 @@ pub trait Engine: Send {
     fn regions(&self) -> Result<Vec<u32>, SolverError>;
     /// Forces of the current state by particle id, and the smallest stable step over
     /// particles before the CFL factor, without advancing.
-    fn forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError>;
+    fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError>;
     /// The cell list of the current state: (cell starts, ids in sorted order).
     fn cell_list(&self) -> Result<(Vec<u32>, Vec<u32>), SolverError>;
     /// Probe sums at the probe points (pressure, fullness of phases 1-3) and the extremes.

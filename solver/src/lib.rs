@@ -18,6 +18,7 @@ pub mod physics;
 pub mod pipeline;
 pub mod simulation;
 pub mod stages;
+pub mod uniform;
 
 pub use backend::Backend;
 pub use config::{Case, ConfigError};

@@ -52,3 +52,18 @@ fn probes_and_extremes_match_the_oracle() {
 fn probe_phase_fullness_matches_the_oracle() {
     stages::check_phase_fullness(&CPU);
 }
+
+#[test]
+fn two_verlet_steps_with_held_sand_match_the_oracle() {
+    stages::check_verlet_steps_with_held_sand(&CPU);
+}
+
+#[test]
+fn rheology_matches_the_oracle_drucker_prager_shields() {
+    stages::check_rheology(&CPU, case("tests/cases/sediment_bed_2d.yaml"), 21);
+}
+
+#[test]
+fn rheology_matches_the_oracle_shields_only() {
+    stages::check_rheology(&CPU, stages::shields_only_case(), 22);
+}

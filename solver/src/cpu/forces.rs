@@ -5,11 +5,23 @@
 
 use super::grid::Grid;
 use crate::physics::interaction::{PairModel, PairSum, Side};
+use crate::physics::sediment::pass::{StressDivergence, StressSide};
+use crate::physics::timestep::particle_viscous_bound;
 use rayon::prelude::*;
 
 /// Particles per block handed to a thread: large enough to amortise the hand-out, small
 /// enough to balance a flume whose particles crowd in a few cells.
 const BLOCK: usize = 512;
+
+/// What the force pass reads besides the particles' sides.
+pub struct Extra<'a> {
+    /// The multiphase model's stress divergence, each particle's stress side and apparent
+    /// viscosity (its explicit viscous bound joins the step).
+    pub stress: Option<(&'a StressDivergence<'a>, &'a [StressSide], &'a [f32])>,
+    /// Particles whose velocity is imposed (an open flume's inlet buffer and duct): their
+    /// acceleration does not bound the step. Empty: none.
+    pub imposed: &'a [bool],
+}
 
 /// Fills `forces` (`[ax, ay, az, d rho/dt]`) and `dt_limit` (the stable step before the CFL
 /// factor) of each particle of `sides`, in sorted order; cells come from `grid`, whose
@@ -19,9 +31,11 @@ pub fn force_pass(
     model: &PairModel,
     grid: &Grid,
     sides: &[Side],
+    extra: &Extra,
     forces: &mut [[f32; 4]],
     dt_limit: &mut [f32],
 ) {
+    let h = model.params().h;
     pool.install(|| {
         forces
             .par_chunks_mut(BLOCK)
@@ -30,14 +44,30 @@ pub fn force_pass(
             .for_each(|(block, (forces, dt_limit))| {
                 let first = block * BLOCK;
                 for (k, (f, dt)) in forces.iter_mut().zip(dt_limit).enumerate() {
-                    let side = &sides[first + k];
+                    let i = first + k;
+                    let side = &sides[i];
                     let mut sum = PairSum::default();
+                    let mut tau = [0.0f32; 3];
                     grid.rows(grid.coords(&side.x), |range| {
-                        for other in &sides[range] {
-                            model.add_pair(side, other, &mut sum);
+                        for j in range.clone() {
+                            model.add_pair(side, &sides[j], &mut sum);
+                        }
+                        if let Some((div, stress, _)) = extra.stress {
+                            for j in range {
+                                div.add_pair(&stress[i], &stress[j], &mut tau);
+                            }
                         }
                     });
-                    (*f, *dt) = model.finish(side, &sum, true);
+                    for (a, t) in sum.acc.iter_mut().zip(tau) {
+                        *a += t;
+                    }
+                    let imposed = extra.imposed.get(i).copied().unwrap_or(false);
+                    (*f, *dt) = model.finish(side, &sum, !imposed);
+                    if let Some((_, _, mu)) = extra.stress
+                        && dt.is_finite()
+                    {
+                        *dt = dt.min(particle_viscous_bound(h, side.rho, mu[i]));
+                    }
                 }
             });
     });

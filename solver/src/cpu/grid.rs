@@ -49,14 +49,22 @@ impl Grid {
     }
 
     /// Sorts particles by (cell, id): returns, for each sorted slot, the storage index of its
-    /// particle, and fills `starts`.
-    pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32]) -> Vec<u32> {
+    /// particle, and fills `starts`. Particles of phase `parked` (an open flume's reservoir)
+    /// go after all cells, in storage order: no neighbour loop visits them.
+    pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32], parked: Option<u32>) -> Vec<u32> {
+        let outside = self.starts.len() as u32 - 1;
         let cells: Vec<u32> = positions
             .iter()
-            .map(|p| self.index(self.coords(&[p[0], p[1], p[2]])) as u32)
+            .map(|p| {
+                if Some(p[3].to_bits()) == parked {
+                    outside
+                } else {
+                    self.index(self.coords(&[p[0], p[1], p[2]])) as u32
+                }
+            })
             .collect();
         self.starts.fill(0);
-        for &c in &cells {
+        for &c in cells.iter().filter(|&&c| c != outside) {
             self.starts[c as usize + 1] += 1;
         }
         for c in 1..self.starts.len() {
@@ -64,9 +72,16 @@ impl Grid {
         }
         let mut cursor = self.starts.clone();
         let mut order = vec![0u32; positions.len()];
+        let mut tail = self.active();
         for (i, &c) in cells.iter().enumerate() {
-            order[cursor[c as usize] as usize] = i as u32;
-            cursor[c as usize] += 1;
+            let slot = if c == outside {
+                tail += 1;
+                tail - 1
+            } else {
+                cursor[c as usize] += 1;
+                cursor[c as usize] - 1
+            };
+            order[slot as usize] = i as u32;
         }
         for c in 0..self.starts.len() - 1 {
             let cell = &mut order[self.starts[c] as usize..self.starts[c + 1] as usize];
@@ -75,6 +90,11 @@ impl Grid {
             }
         }
         order
+    }
+
+    /// Particles in cells after the last sort (the parked ones are not).
+    pub fn active(&self) -> u32 {
+        self.starts[self.starts.len() - 1]
     }
 
     /// Calls `visit` with the sorted-index range of each row of cells within reach of cell

@@ -1,34 +1,34 @@
 //! The native CPU backend: the stages of `pipeline.rs` in the same order on the same uniform,
 //! written in plain Rust over the particle state in cell order and shared out among threads
-//! with rayon. The formulas are those of `solver::physics` (pair terms, integrators, probes),
-//! called per pair and per particle: the backend adds the loops, not the physics.
+//! with rayon. The formulas are those of `solver::physics` (pair terms, rheology, release,
+//! integrators, probes), called per pair and per particle: the backend adds the loops, not the
+//! physics.
 //!
-//! It runs the water model (closed tanks, artificial or laminar viscosity, either
-//! integrator); `unsupported` names what it does not run yet, and `Backend::choose` sends
-//! those cases to a wgpu adapter.
+//! It runs every case the wgpu backend runs: the water model, the water-sediment model with
+//! its holds, and the open flume. An open flume's parked particles sort after every cell and
+//! take no part in the neighbour passes or the integrators.
 
 mod forces;
 mod grid;
+mod multiphase;
 mod observe;
 mod step;
+mod store;
 
 use crate::case::Particles;
-use crate::config::{Case, Viscosity};
+use crate::config::Case;
 use crate::engine::{Engine, RawState, StageTime};
 use crate::gpu::engine::{PipelineShape, by_id};
-use crate::gpu::params::{Extremes, SimParams, StepState};
+use crate::gpu::params::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
 use crate::physics;
+use crate::physics::sediment::pass::SedimentModel;
+use crate::physics::sediment::suspension::Region;
 use crate::simulation::SolverError;
 use grid::Grid;
 
-/// Why the CPU backend cannot run `case`, or None when it can.
-pub fn unsupported(case: &Case) -> Option<String> {
-    if matches!(case.numerics.viscosity, Viscosity::Multiphase { .. }) {
-        return Some("does not run the multiphase (sediment) model yet".into());
-    }
-    if case.open_flume.is_some() {
-        return Some("does not run open flumes (inlet, outlet, collector) yet".into());
-    }
+/// Why the CPU backend cannot run `case`, or None when it can. It runs them all; the choice of
+/// backend asks, so that a case it could not run would go to a wgpu adapter.
+pub fn unsupported(_case: &Case) -> Option<String> {
     None
 }
 
@@ -66,8 +66,8 @@ impl State {
     }
 }
 
-/// The stages timed apart, in step order.
-const STAGES: [&str; 4] = ["sort", "forces", "integrate", "observe"];
+/// The stages timed apart, in step order; "forces" includes the rheology and release passes.
+const STAGES: [&str; 3] = ["sort", "forces", "integrate"];
 
 pub struct CpuEngine {
     pool: rayon::ThreadPool,
@@ -75,11 +75,15 @@ pub struct CpuEngine {
     params: SimParams,
     model: physics::Params,
     shape: PipelineShape,
+    /// The sediment model, None without the multiphase viscosity.
+    sediment: Option<SedimentModel>,
     a: State,
-    snapshot: State,
+    /// Region words by id (region | REGION_HELD), as the last rheology pass left them.
+    regions: Vec<u32>,
+    snapshot: (State, Vec<u32>),
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
-    seconds: std::cell::Cell<[f64; 4]>,
+    seconds: [f64; 3],
 }
 
 impl CpuEngine {
@@ -87,6 +91,7 @@ impl CpuEngine {
         threads: usize,
         params: &SimParams,
         n_phases: usize,
+        sediment: Option<SedimentModel>,
         particles: &Particles,
         probe_points: &[[f32; 4]],
         shape: PipelineShape,
@@ -102,16 +107,19 @@ impl CpuEngine {
             ids: particles.ids.clone(),
             vel_rho_prev: particles.vel_rho.clone(),
         };
+        let regions = vec![0; particles.len()];
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
             pool,
             params: *params,
             model: params.physics(shape.dim, n_phases),
             shape,
-            snapshot: a.clone(),
+            sediment: sediment.filter(|_| params.viscosity_mode == VISCOSITY_MULTIPHASE),
+            snapshot: (a.clone(), regions.clone()),
             a,
+            regions,
             probe_points: probe_points.to_vec(),
-            seconds: std::cell::Cell::new([0.0; 4]),
+            seconds: [0.0; 3],
         })
     }
 
@@ -120,10 +128,22 @@ impl CpuEngine {
     }
 
     /// Adds the time since `start` to stage `k` of `STAGES`.
-    fn timed(&self, k: usize, start: std::time::Instant) {
-        let mut s = self.seconds.get();
-        s[k] += start.elapsed().as_secs_f64();
-        self.seconds.set(s);
+    fn timed(&mut self, k: usize, start: std::time::Instant) {
+        self.seconds[k] += start.elapsed().as_secs_f64();
+    }
+
+    /// The parked phase of an open flume, None for a closed tank.
+    fn parked_phase(&self) -> Option<u32> {
+        (self.params.flume.enabled != 0).then_some(self.params.flume.parked_phase)
+    }
+
+    /// Whether sorted slot `k` of `b` is un-yielded sediment (region 1): the probes' fourth
+    /// sum, whose top is the bed interface Zb.
+    fn unyielded_sediment(&self, b: &State, k: usize) -> bool {
+        let sediment = self.params.sediment.phase;
+        sediment != 0
+            && b.positions[k][3].to_bits() == sediment
+            && self.regions[b.ids[k] as usize] & 255 == Region::Unyielded as u32
     }
 }
 
@@ -138,11 +158,13 @@ impl Engine for CpuEngine {
     }
 
     fn save(&mut self) {
-        self.snapshot.clone_from(&self.a);
+        self.snapshot.0.clone_from(&self.a);
+        self.snapshot.1.clone_from(&self.regions);
     }
 
     fn restore(&mut self) {
-        self.a.clone_from(&self.snapshot);
+        self.a.clone_from(&self.snapshot.0);
+        self.regions.clone_from(&self.snapshot.1);
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {
@@ -170,48 +192,37 @@ impl Engine for CpuEngine {
     }
 
     fn regions(&self) -> Result<Vec<u32>, SolverError> {
-        // No multiphase model: no regions and no holds.
-        Ok(vec![0; self.a.ids.len()])
+        Ok(self.regions.clone())
     }
 
-    fn forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
-        let mut grid = self.grid();
-        let b = self.a.gather(&grid.sort(&self.a.positions, &self.a.ids));
-        let (forces, dt_limit) = self.force_pass(&grid, &b.positions, &b.vel_rho);
+    fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
+        let (grid, b) = self.sorted();
+        let (mut forces, dt_limit) = self.force_pass(&grid, &b, &b.positions, &b.vel_rho);
+        // Parked particles feel nothing.
+        forces.resize(b.ids.len(), [0.0; 4]);
         Ok((by_id(&forces, &b.ids), forces::min_dt(&dt_limit)))
     }
 
     fn cell_list(&self) -> Result<(Vec<u32>, Vec<u32>), SolverError> {
-        let mut grid = self.grid();
-        let order = grid.sort(&self.a.positions, &self.a.ids);
-        Ok((grid.starts, grid::gather(&self.a.ids, &order)))
+        let (grid, b) = self.sorted();
+        Ok((grid.starts, b.ids))
     }
 
     fn observe(&self) -> Result<(Vec<[f32; 4]>, Extremes), SolverError> {
-        let start = std::time::Instant::now();
-        let mut grid = self.grid();
-        let b = self.a.gather(&grid.sort(&self.a.positions, &self.a.ids));
+        let (grid, b) = self.sorted();
+        let unyielded = |k: usize| self.unyielded_sediment(&b, k);
         let sums = self.probe_points.iter().map(|p| {
-            observe::probe_sums(
-                &self.model,
-                &grid,
-                [p[0], p[1], p[2]],
-                &b.positions,
-                &b.vel_rho,
-            )
+            let point = [p[0], p[1], p[2]];
+            observe::probe_sums(&self.model, &grid, point, &b, &unyielded)
         });
-        let out = (
-            sums.collect(),
-            observe::extremes(&self.model, &self.a.positions, &self.a.vel_rho),
-        );
-        self.timed(3, start);
-        Ok(out)
+        let extremes = observe::extremes(&self.model, &self.a.positions, &self.a.vel_rho);
+        Ok((sums.collect(), extremes))
     }
 
     fn stage_times(&self) -> Vec<StageTime> {
         STAGES
             .iter()
-            .zip(self.seconds.get())
+            .zip(self.seconds)
             .map(|(&stage, seconds)| StageTime { stage, seconds })
             .collect()
     }

@@ -2,28 +2,35 @@
 //! over the cell list, as `probe_interpolate.wgsl`) and the whole-state extremes of
 //! `observe_reduce.wgsl`.
 
+use super::State;
 use super::grid::Grid;
 use crate::gpu::params::{Extremes, order_key};
 use crate::physics::Params;
 use crate::physics::interaction::phase_index;
 use crate::physics::probe::{ProbeSums, add_particle};
 
-/// The sums at `point` in the GPU's layout: pressure sum, then the fullness of phases 1-3.
+/// The sums at `point` in the GPU's layout: pressure sum, then the fullness of phases 1-3;
+/// with a sediment (two fluid phases) the last is the fullness of the un-yielded sediment,
+/// `unyielded(k)` for sorted slot k of `b`.
 pub fn probe_sums(
     model: &Params,
     grid: &Grid,
     point: [f32; 3],
-    positions: &[[f32; 4]],
-    vel_rho: &[[f32; 4]],
+    b: &State,
+    unyielded: &dyn Fn(usize) -> bool,
 ) -> [f32; 4] {
     let mut sums = ProbeSums::default();
+    let mut bed = 0.0;
     grid.rows(grid.coords(&point), |range| {
         for j in range {
-            add_particle(model, point, &positions[j], &vel_rho[j], &mut sums);
+            let vw = add_particle(model, point, &b.positions[j], &b.vel_rho[j], &mut sums);
+            if vw > 0.0 && unyielded(j) {
+                bed += vw;
+            }
         }
     });
     let f = sums.phase_fullness;
-    [sums.pressure_sum, f[1], f[2], f[3]]
+    [sums.pressure_sum, f[1], f[2], f[3] + bed]
 }
 
 /// The surge front (largest x of a mobile particle), the largest speed and relative density

@@ -1,38 +1,112 @@
-//! One step of the CPU backend, in the order of `SphPipeline::record_step`: sort, forces at n,
-//! the time step, then the Verlet update, or the symplectic predictor, forces at n + 1/2 and
-//! corrector. The particle formulas are `physics::integrate`'s; `store` is the CPU side of
-//! `store_state.wgsl` for a closed tank, and `dt_update` mirrors `dt_update.wgsl`.
+//! One step of the CPU backend, in the order of `SphPipeline::record_step`: sort, (rheology,
+//! release and) forces at n, the time step, then the Verlet update, or the symplectic
+//! predictor, (rheology, release and) forces at n + 1/2 and corrector. The particle formulas
+//! are `physics::integrate`'s; `store.rs` ends each particle's step, and `dt_update` mirrors
+//! `dt_update.wgsl`.
 
-use super::forces::{force_pass, min_dt};
+use super::forces::{Extra, force_pass, min_dt};
 use super::grid::Grid;
+use super::multiphase::rheology_pass;
+use super::store::{Event, Store, tally};
 use super::{CpuEngine, State};
 use crate::gpu::params::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, correct, predict, verlet_step};
-use crate::physics::interaction::{PairModel, Side, phase_index};
-use crate::physics::{Params, Phase};
+use crate::physics::interaction::{PairModel, Side};
+use crate::physics::sediment::pass::{REGION_HELD, StressDivergence, StressSide};
 use rayon::prelude::*;
 use std::time::Instant;
 
 impl CpuEngine {
-    /// Forces and stable steps of particles in sorted order, their cells from `grid`.
+    /// Sorts the state into cells: the sorted copy and its grid.
+    pub(super) fn sorted(&self) -> (Grid, State) {
+        let mut grid = self.grid();
+        let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
+        (grid, self.a.gather(&order))
+    }
+
+    /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
+    fn holds(&self, b: &State) -> Vec<bool> {
+        let phases = &self.model.phases;
+        b.positions
+            .iter()
+            .zip(&b.ids)
+            .map(|(x, &id)| {
+                phases[x[3].to_bits() as usize].mobile
+                    && self.regions[id as usize] & REGION_HELD != 0
+            })
+            .collect()
+    }
+
+    /// (Rheology and release, then) forces and stable steps of the active particles of `b`
+    /// at positions `pos`, velocities `vel` (sorted order), cells from `grid`.
     pub(super) fn force_pass(
-        &self,
+        &mut self,
         grid: &Grid,
-        positions: &[[f32; 4]],
-        vel_rho: &[[f32; 4]],
+        b: &State,
+        pos: &[[f32; 4]],
+        vel: &[[f32; 4]],
     ) -> (Vec<[f32; 4]>, Vec<f32>) {
-        let model = PairModel::new(&self.model);
-        let sides: Vec<Side> = self.pool.install(|| {
-            positions
-                .par_iter()
-                .zip(vel_rho)
-                .map(|(p, v)| model.side(p, v))
-                .collect()
+        let active = grid.active() as usize;
+        let rheology = self.sediment.as_ref().map(|model| {
+            let holds = self.holds(b);
+            let release = self.shape.yield_release;
+            let (params, pool) = (&self.model, &self.pool);
+            rheology_pass(
+                pool,
+                params,
+                model,
+                grid,
+                pos,
+                vel,
+                &holds[..active],
+                release,
+            )
         });
-        let n = positions.len();
-        let (mut forces, mut dt_limit) = (vec![[0.0; 4]; n], vec![0.0; n]);
-        force_pass(&self.pool, &model, grid, &sides, &mut forces, &mut dt_limit);
+        if let Some(out) = &rheology {
+            for (r, &id) in out.iter().zip(&b.ids) {
+                self.regions[id as usize] = r.word();
+            }
+            // Parked particles are out of the flow: no region.
+            for &id in &b.ids[active..] {
+                self.regions[id as usize] = 0;
+            }
+        }
+        let model = PairModel::new(&self.model);
+        let store = Store::new(&self.params, &self.model);
+        let (sides, imposed): (Vec<Side>, Vec<bool>) = self.pool.install(|| {
+            (0..active)
+                .into_par_iter()
+                .map(|i| {
+                    (
+                        model.side(&pos[i], &vel[i]),
+                        store.velocity_imposed(&pos[i]),
+                    )
+                })
+                .unzip()
+        });
+        let div = StressDivergence::new(&self.model);
+        let stress: Option<(Vec<StressSide>, Vec<f32>)> = rheology.map(|r| {
+            (0..active)
+                .map(|i| (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu))
+                .unzip()
+        });
+        let extra = Extra {
+            stress: stress
+                .as_ref()
+                .map(|(s, mu)| (&div, s.as_slice(), mu.as_slice())),
+            imposed: &imposed,
+        };
+        let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
+        force_pass(
+            &self.pool,
+            &model,
+            grid,
+            &sides,
+            &extra,
+            &mut forces,
+            &mut dt_limit,
+        );
         (forces, dt_limit)
     }
 
@@ -40,14 +114,13 @@ impl CpuEngine {
     /// raised), as the GPU's idle steps past the end of a chunk.
     pub(super) fn step(&mut self, st: &mut StepState) -> bool {
         let start = Instant::now();
-        let mut grid = self.grid();
-        let b = self.a.gather(&grid.sort(&self.a.positions, &self.a.ids));
+        let (grid, b) = self.sorted();
         self.timed(0, start);
         let start = Instant::now();
         let mut forces = Vec::new();
         if st.t_rel < st.t_target && st.status == 0 {
             let dt_limit;
-            (forces, dt_limit) = self.force_pass(&grid, &b.positions, &b.vel_rho);
+            (forces, dt_limit) = self.force_pass(&grid, &b, &b.positions, &b.vel_rho);
             let stable = f32::from_bits(st.dt_min_bits).min(min_dt(&dt_limit));
             st.dt_min_bits = stable.to_bits();
         }
@@ -71,131 +144,97 @@ impl CpuEngine {
         let euler = (st.step_base + st.steps - 1).is_multiple_of(self.params.euler_every.max(1));
         let (dt, dt_prev) = (st.dt, st.dt_prev);
         let store = Store::new(&self.params, &self.model);
-        let phases = &self.model.phases;
-        let mut next = State {
-            positions: vec![[0.0; 4]; b.ids.len()],
-            vel_rho: vec![[0.0; 4]; b.ids.len()],
-            ids: Vec::new(),
-            vel_rho_prev: Vec::new(),
-        };
-        let flags = self.pool.install(|| {
-            (next.positions.par_iter_mut(), next.vel_rho.par_iter_mut())
+        let holds = self.holds(&b);
+        let stored: Vec<(Particle, [f32; 4], Event)> = self.pool.install(|| {
+            (0..b.ids.len())
                 .into_par_iter()
-                .enumerate()
-                .map(|(i, (x_out, v_out))| {
+                .map(|i| {
                     let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-                    let phase = &phases[phase_index(x)];
-                    let moved = verlet_step(
-                        phase,
-                        dt,
-                        dt_prev,
-                        euler,
-                        x,
-                        v,
-                        &b.vel_rho_prev[i],
-                        &forces[i],
-                    );
-                    let flags;
-                    ((*x_out, *v_out), flags) = store.apply(phase, moved);
-                    flags
+                    let Some(f) = forces.get(i) else {
+                        // Parked: out of the flow.
+                        return ((*x, *v), *v, Event::default());
+                    };
+                    let held = holds[i];
+                    let phase = store.phase(x);
+                    let moved = verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f);
+                    let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
+                    // Held sediment is at rest in both of the leapfrog's sequences.
+                    let prev = if held { [0.0, 0.0, 0.0, v[3]] } else { *v };
+                    (out, prev, event)
                 })
-                .reduce(|| 0, |a, b| a | b)
+                .collect()
         });
-        st.status |= flags;
-        next.ids = b.ids;
-        next.vel_rho_prev = b.vel_rho;
-        self.a = next;
+        self.finish_step(st, b.ids, stored);
     }
 
     fn symplectic(&mut self, st: &mut StepState, grid: &Grid, b: State, forces: &[[f32; 4]]) {
         let start = Instant::now();
         let dt = st.dt;
         let store = Store::new(&self.params, &self.model);
-        let phases = &self.model.phases;
+        let holds = self.holds(&b);
         let half: Vec<Particle> = self.pool.install(|| {
             (0..b.ids.len())
                 .into_par_iter()
                 .map(|i| {
-                    let phase = &phases[phase_index(&b.positions[i])];
-                    let (x, mut v) = predict(phase, dt, &b.positions[i], &b.vel_rho[i], &forces[i]);
-                    if phase.mobile && store.clamp {
-                        v[3] = v[3].max(phase.rho0);
-                    }
-                    (x, v)
+                    let (x, v) = (&b.positions[i], &b.vel_rho[i]);
+                    let Some(f) = forces.get(i) else {
+                        return (*x, *v);
+                    };
+                    let free = predict(store.phase(x), dt, x, v, f);
+                    store.half_step(x, v, holds[i], 0.5 * dt, free)
                 })
                 .collect()
         });
         let (x_half, v_half): (Vec<[f32; 4]>, Vec<[f32; 4]>) = half.into_iter().unzip();
         self.timed(2, start);
         let start = Instant::now();
-        let (forces_half, _) = self.force_pass(grid, &x_half, &v_half);
+        let (forces_half, _) = self.force_pass(grid, &b, &x_half, &v_half);
         self.timed(1, start);
         let start = Instant::now();
-        let phases = &self.model.phases;
-        let (moved, flags): (Vec<Particle>, Vec<u32>) = self.pool.install(|| {
+        let store = Store::new(&self.params, &self.model);
+        // The corrector's rheology pass has set the holds again.
+        let holds = self.holds(&b);
+        let stored: Vec<(Particle, [f32; 4], Event)> = self.pool.install(|| {
             (0..b.ids.len())
                 .into_par_iter()
                 .map(|i| {
                     let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-                    let phase = &phases[phase_index(x)];
-                    store.apply(
-                        phase,
-                        correct(phase, dt, x, v, v_half[i][3], &forces_half[i]),
-                    )
+                    let Some(f) = forces_half.get(i) else {
+                        return ((*x, *v), b.vel_rho_prev[i], Event::default());
+                    };
+                    let moved = correct(store.phase(x), dt, x, v, v_half[i][3], f);
+                    let (out, event) = store.apply(b.ids[i], x, v, holds[i], dt, moved);
+                    (out, b.vel_rho_prev[i], event)
                 })
-                .unzip()
+                .collect()
         });
-        st.status |= flags.iter().fold(0, |a, f| a | f);
-        let (positions, vel_rho) = moved.into_iter().unzip();
-        self.a = State {
-            positions,
-            vel_rho,
-            ids: b.ids,
-            vel_rho_prev: b.vel_rho_prev,
-        };
+        self.finish_step(st, b.ids, stored);
         self.timed(2, start);
     }
-}
 
-/// The end of a step for a closed tank (`store_state.wgsl`): without tension a free
-/// particle's density never falls below rest; its new state raises the health flags.
-struct Store {
-    clamp: bool,
-    rho_ratio_max: f32,
-}
-
-impl Store {
-    fn new(params: &SimParams, model: &Params) -> Store {
-        Store {
-            clamp: model.clamp_negative_pressure,
-            rho_ratio_max: params.rho_ratio_max,
-        }
-    }
-
-    /// The particle as stored, and the health flags it raises (walls raise none).
-    fn apply(&self, phase: &Phase, (x, mut v): Particle) -> (Particle, u32) {
-        if !phase.mobile {
-            return ((x, v), 0);
-        }
-        if self.clamp {
-            v[3] = v[3].max(phase.rho0);
-        }
-        let s = x[0] * x[0]
-            + x[1] * x[1]
-            + x[2] * x[2]
-            + v[0] * v[0]
-            + v[1] * v[1]
-            + v[2] * v[2]
-            + v[3];
-        // Infinities (and sums near them) exceed the bound of store_state.wgsl.
-        let flags = if s.is_nan() || s.abs() > 3.0e38 {
-            Health::NON_FINITE
-        } else if (v[3] / phase.rho0 - 1.0).abs() > self.rho_ratio_max {
-            Health::DENSITY_RUNAWAY
-        } else {
-            0
+    /// Takes the stored particles as the new state and their events into the step state.
+    fn finish_step(
+        &mut self,
+        st: &mut StepState,
+        ids: Vec<u32>,
+        stored: Vec<(Particle, [f32; 4], Event)>,
+    ) {
+        let n = stored.len();
+        let mut next = State {
+            positions: Vec::with_capacity(n),
+            vel_rho: Vec::with_capacity(n),
+            ids,
+            vel_rho_prev: Vec::with_capacity(n),
         };
-        ((x, v), flags)
+        let mut events = Vec::with_capacity(n);
+        for ((x, v), prev, event) in stored {
+            next.positions.push(x);
+            next.vel_rho.push(v);
+            next.vel_rho_prev.push(prev);
+            events.push(event);
+        }
+        tally(st, &events);
+        self.a = next;
     }
 }
 

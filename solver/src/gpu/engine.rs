@@ -187,7 +187,7 @@ impl Engine for GpuEngine {
         Ok(cast_vec(&raw[0]))
     }
 
-    fn forces(&self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
+    fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
         self.write_state(&StepState::chunk(f32::MAX, 0.0, 0.0, 0));
         self.submit(|pass| self.pipeline.record_forces(pass, &self.bindings));

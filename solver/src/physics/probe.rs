@@ -49,31 +49,32 @@ pub fn probe(
     sums
 }
 
-/// Adds particle `x`, `v` to the kernel sums at `point`: nothing from a wall or from beyond
-/// the support 2h.
+/// Adds particle `x`, `v` to the kernel sums at `point` and returns its weight `V W`:
+/// nothing (zero) from a wall or from beyond the support 2h.
 pub fn add_particle(
     params: &Params,
     point: [f32; 3],
     x: &[f32; 4],
     v: &[f32; 4],
     sums: &mut ProbeSums,
-) {
+) -> f32 {
     let k = phase_index(x);
     let phase = &params.phases[k];
     if !phase.mobile {
-        return;
+        return 0.0;
     }
     let h = params.h;
     let d = [point[0] - x[0], point[1] - x[1], point[2] - x[2]];
     let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
     if r2 >= 4.0 * h * h {
-        return;
+        return 0.0;
     }
     let rho = v[3];
     let vw = phase.mass / rho * w(r2.sqrt(), h, params.dim);
     sums.fullness += vw;
     sums.phase_fullness[k] += vw;
     sums.pressure_sum += vw * pressure(rho, phase.rho0, tait_b(params.c0, phase.rho0));
+    vw
 }
 
 /// Water level on a vertical line sampled at ascending `heights` with kernel `fullness` values.

@@ -15,6 +15,16 @@ pub fn step_size(params: &Params, dt_limits: &[f32], dt_visc: f32) -> f32 {
     params.cfl * dt_min
 }
 
+/// One particle's explicit viscous bound `0.125 h^2 rho / mu`, s, with its own density and
+/// apparent viscosity (the multiphase model's); `f32::INFINITY` when `mu` is not positive.
+pub fn particle_viscous_bound(h: f32, rho: f32, mu: f32) -> f32 {
+    if mu > 0.0 {
+        0.125 * h * h * rho / mu
+    } else {
+        f32::INFINITY
+    }
+}
+
 /// Viscous stability bound, s: the smallest `0.125 h^2 rho0 / mu` over mobile phases with
 /// `mu > 0`; `f32::INFINITY` if there is none.
 pub fn viscous_dt_bound(h: f32, phases: &[Phase]) -> f32 {

@@ -72,9 +72,9 @@ pub struct Transmitted {
 impl Transmitted {
     pub fn add(&mut self, weight: f32, tau: &Tensor3) {
         self.weight += weight;
-        for a in 0..3 {
-            for b in 0..3 {
-                self.tau[a][b] += weight * tau[a][b];
+        for (row, t_row) in self.tau.iter_mut().zip(tau) {
+            for (x, t) in row.iter_mut().zip(t_row) {
+                *x += weight * t;
             }
         }
     }
@@ -132,9 +132,7 @@ impl<'a> Release<'a> {
 
     /// Whether the release decides on particle `x` of this rheology: held sediment.
     pub fn applies(&self, x: &[f32; 4], rheology: &ParticleRheology) -> bool {
-        !self.model.shields_only
-            && rheology.held
-            && phase_index(x) == self.model.sediment_phase
+        !self.model.shields_only && rheology.held && phase_index(x) == self.model.sediment_phase
     }
 
     /// Adds neighbour j (position, velocity-density, rheology) to a held particle at `x_i`:

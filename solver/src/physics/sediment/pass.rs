@@ -58,6 +58,17 @@ pub struct ParticleRheology {
     pub held: bool,
 }
 
+/// Bit of a region word marking sediment held fixed; mirrors `REGION_HELD` of
+/// `shaders/common/sediment.wgsl`.
+pub const REGION_HELD: u32 = 256;
+
+impl ParticleRheology {
+    /// The region word the backends store per particle: the region, and `REGION_HELD`.
+    pub fn word(&self) -> u32 {
+        self.region | if self.held { REGION_HELD } else { 0 }
+    }
+}
+
 /// Sums a particle gathers from its neighbours in the rheology pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RheologySums {
@@ -212,9 +223,9 @@ impl<'a> Rheology<'a> {
         let r = r2.sqrt();
         let f = self.kernel.grad_factor(r);
         let du = sub3(v_j, v_i);
-        for a in 0..3 {
-            for b in 0..3 {
-                s.grad[a][b] += vol_j * du[a] * x_ij[b] * f;
+        for (row, d) in s.grad.iter_mut().zip(du) {
+            for (g, x) in row.iter_mut().zip(x_ij) {
+                *g += vol_j * d * x * f;
             }
         }
         let model = self.model;
@@ -418,10 +429,9 @@ impl<'a> StressDivergence<'a> {
             phase_j.mass * wall_scale(phases[i.phase as usize].rho0, phase_j.rho0)
         };
         let f = self.kernel.grad_factor(r2.sqrt());
-        for a in 0..3 {
-            for b in 0..3 {
-                let t = i.tau_over_rho2[a][b] + j.tau_over_rho2[a][b];
-                acc[a] += m_j * t * x_ij[b] * f;
+        for ((a, t_i), t_j) in acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2) {
+            for ((ti, tj), x) in t_i.iter().zip(t_j).zip(x_ij) {
+                *a += m_j * (ti + tj) * x * f;
             }
         }
     }
