@@ -95,29 +95,47 @@ fn missing_case_file_is_reported() {
     );
 }
 
-#[test]
-fn missing_adapter_says_how_to_get_one() {
-    let dir = scratch("no_adapter");
+/// `simulate` with the Vulkan loader pointed at no driver, and `FLUME_TWIN_ADAPTER` set to
+/// `adapter` (None: unset).
+fn simulate_without_a_driver(dir: &std::path::Path, adapter: Option<&str>) -> std::process::Output {
     // WGPU_BACKEND=vulkan keeps wgpu off GL (llvmpipe would answer there); the two loader
     // variables (new and legacy name) point the Vulkan loader at no driver at all.
-    let out = Command::new(BIN)
-        .args([
-            "simulate",
-            repo_file("launch_configs/dambreak_water.yaml")
-                .to_str()
-                .unwrap(),
-        ])
-        .args([
-            "--until",
-            "0.001",
-            "--out",
-            dir.join("out").to_str().unwrap(),
-        ])
-        .env("WGPU_BACKEND", "vulkan")
-        .env("VK_ICD_FILENAMES", "/nonexistent.json")
-        .env("VK_DRIVER_FILES", "/nonexistent.json")
-        .output()
-        .unwrap();
+    let mut cmd = Command::new(BIN);
+    cmd.args([
+        "simulate",
+        repo_file("launch_configs/dambreak_water.yaml")
+            .to_str()
+            .unwrap(),
+    ])
+    .args([
+        "--until",
+        "0.001",
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ])
+    .env("WGPU_BACKEND", "vulkan")
+    .env("VK_ICD_FILENAMES", "/nonexistent.json")
+    .env("VK_DRIVER_FILES", "/nonexistent.json")
+    .env_remove("FLUME_TWIN_ADAPTER");
+    if let Some(a) = adapter {
+        cmd.env("FLUME_TWIN_ADAPTER", a);
+    }
+    cmd.output().unwrap()
+}
+
+/// Without any adapter the twin runs on the CPU backend and says so; asked for an adapter
+/// that is not there, it fails and says how to get lavapipe.
+#[test]
+fn without_an_adapter_the_cpu_backend_runs_and_a_named_one_says_how_to_get_it() {
+    let dir = scratch("no_adapter");
+    let out = simulate_without_a_driver(&dir, None);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        stdout.starts_with("adapter: native CPU backend"),
+        "{stdout}"
+    );
+    let out = simulate_without_a_driver(&dir, Some("llvmpipe"));
     let stderr = text(&out.stderr);
     assert!(
         !out.status.success(),

@@ -15,9 +15,9 @@ const BLOCK: usize = 512;
 
 /// What the force pass reads besides the particles' sides.
 pub struct Extra<'a> {
-    /// The multiphase model's stress divergence, each particle's stress side and apparent
-    /// viscosity (its explicit viscous bound joins the step).
-    pub stress: Option<(&'a StressDivergence<'a>, &'a [StressSide], &'a [f32])>,
+    /// The multiphase model's stress side and apparent viscosity of each particle (its
+    /// explicit viscous bound joins the step).
+    pub stress: Option<(&'a [StressSide], &'a [f32])>,
     /// Particles whose velocity is imposed (an open flume's inlet buffer and duct): their
     /// acceleration does not bound the step. Empty: none.
     pub imposed: &'a [bool],
@@ -48,13 +48,19 @@ pub fn force_pass(
                     let side = &sides[i];
                     let mut sum = PairSum::default();
                     let mut tau = [0.0f32; 3];
-                    grid.rows(grid.coords(&side.x), |range| {
-                        for j in range.clone() {
-                            model.add_pair(side, &sides[j], &mut sum);
-                        }
-                        if let Some((div, stress, _)) = extra.stress {
+                    grid.rows(grid.coords(&side.x), |range| match extra.stress {
+                        None => {
                             for j in range {
-                                div.add_pair(&stress[i], &stress[j], &mut tau);
+                                model.add_pair(side, &sides[j], &mut sum);
+                            }
+                        }
+                        Some((stress, _)) => {
+                            for j in range {
+                                if let Some(g) = model.add_pair(side, &sides[j], &mut sum) {
+                                    StressDivergence::add_term(
+                                        &stress[i], &stress[j], &g, &mut tau,
+                                    );
+                                }
                             }
                         }
                     });
@@ -63,7 +69,7 @@ pub fn force_pass(
                     }
                     let imposed = extra.imposed.get(i).copied().unwrap_or(false);
                     (*f, *dt) = model.finish(side, &sum, !imposed);
-                    if let Some((_, _, mu)) = extra.stress
+                    if let Some((_, mu)) = extra.stress
                         && dt.is_finite()
                     {
                         *dt = dt.min(particle_viscous_bound(h, side.rho, mu[i]));

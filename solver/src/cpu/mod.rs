@@ -66,8 +66,12 @@ impl State {
     }
 }
 
-/// The stages timed apart, in step order; "forces" includes the rheology and release passes.
-const STAGES: [&str; 3] = ["sort", "forces", "integrate"];
+/// The stages timed apart, in step order; "rheology" includes the release of held sand.
+const STAGES: [&str; 4] = ["sort", "rheology", "forces", "integrate"];
+const STAGE_SORT: usize = 0;
+const STAGE_RHEOLOGY: usize = 1;
+const STAGE_FORCES: usize = 2;
+const STAGE_INTEGRATE: usize = 3;
 
 pub struct CpuEngine {
     pool: rayon::ThreadPool,
@@ -83,7 +87,7 @@ pub struct CpuEngine {
     snapshot: (State, Vec<u32>),
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
-    seconds: [f64; 3],
+    seconds: [f64; 4],
 }
 
 impl CpuEngine {
@@ -119,7 +123,7 @@ impl CpuEngine {
             a,
             regions,
             probe_points: probe_points.to_vec(),
-            seconds: [0.0; 3],
+            seconds: [0.0; 4],
         })
     }
 

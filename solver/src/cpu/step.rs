@@ -8,7 +8,7 @@ use super::forces::{Extra, force_pass, min_dt};
 use super::grid::Grid;
 use super::multiphase::rheology_pass;
 use super::store::{Event, Store, tally};
-use super::{CpuEngine, State};
+use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
 use crate::gpu::params::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, correct, predict, verlet_step};
@@ -48,6 +48,7 @@ impl CpuEngine {
         vel: &[[f32; 4]],
     ) -> (Vec<[f32; 4]>, Vec<f32>) {
         let active = grid.active() as usize;
+        let start = Instant::now();
         let rheology = self.sediment.as_ref().map(|model| {
             let holds = self.holds(b);
             let release = self.shape.yield_release;
@@ -72,6 +73,8 @@ impl CpuEngine {
                 self.regions[id as usize] = 0;
             }
         }
+        self.timed(STAGE_RHEOLOGY, start);
+        let start = Instant::now();
         let model = PairModel::new(&self.model);
         let store = Store::new(&self.params, &self.model);
         let (sides, imposed): (Vec<Side>, Vec<bool>) = self.pool.install(|| {
@@ -92,9 +95,7 @@ impl CpuEngine {
                 .unzip()
         });
         let extra = Extra {
-            stress: stress
-                .as_ref()
-                .map(|(s, mu)| (&div, s.as_slice(), mu.as_slice())),
+            stress: stress.as_ref().map(|(s, mu)| (s.as_slice(), mu.as_slice())),
             imposed: &imposed,
         };
         let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
@@ -107,6 +108,7 @@ impl CpuEngine {
             &mut forces,
             &mut dt_limit,
         );
+        self.timed(STAGE_FORCES, start);
         (forces, dt_limit)
     }
 
@@ -115,8 +117,7 @@ impl CpuEngine {
     pub(super) fn step(&mut self, st: &mut StepState) -> bool {
         let start = Instant::now();
         let (grid, b) = self.sorted();
-        self.timed(0, start);
-        let start = Instant::now();
+        self.timed(STAGE_SORT, start);
         let mut forces = Vec::new();
         if st.t_rel < st.t_target && st.status == 0 {
             let dt_limit;
@@ -124,7 +125,6 @@ impl CpuEngine {
             let stable = f32::from_bits(st.dt_min_bits).min(min_dt(&dt_limit));
             st.dt_min_bits = stable.to_bits();
         }
-        self.timed(1, start);
         dt_update(&self.params, st);
         if st.dt == 0.0 {
             return false;
@@ -132,7 +132,7 @@ impl CpuEngine {
         if self.shape.verlet {
             let start = Instant::now();
             self.verlet(st, b, &forces);
-            self.timed(2, start);
+            self.timed(STAGE_INTEGRATE, start);
         } else {
             self.symplectic(st, &grid, b, &forces);
         }
@@ -186,10 +186,8 @@ impl CpuEngine {
                 .collect()
         });
         let (x_half, v_half): (Vec<[f32; 4]>, Vec<[f32; 4]>) = half.into_iter().unzip();
-        self.timed(2, start);
-        let start = Instant::now();
+        self.timed(STAGE_INTEGRATE, start);
         let (forces_half, _) = self.force_pass(grid, &b, &x_half, &v_half);
-        self.timed(1, start);
         let start = Instant::now();
         let store = Store::new(&self.params, &self.model);
         // The corrector's rheology pass has set the holds again.
@@ -209,7 +207,7 @@ impl CpuEngine {
                 .collect()
         });
         self.finish_step(st, b.ids, stored);
-        self.timed(2, start);
+        self.timed(STAGE_INTEGRATE, start);
     }
 
     /// Takes the stored particles as the new state and their events into the step state.

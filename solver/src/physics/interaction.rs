@@ -75,6 +75,15 @@ struct PhaseConsts {
 /// Slots of the phase table; a power of two, the GPU uniform's `MAX_PHASES`.
 const PHASE_SLOTS: usize = 4;
 
+/// A pair within the kernel's support: `x_i - x_j`, the kernel factor F of
+/// `grad_i W_ij = x_ij F`, and the neighbour's mass as `i` sees it (a wall's scaled).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairGeometry {
+    pub x_ij: [f32; 3],
+    pub f: f32,
+    pub m_j: f32,
+}
+
 /// The running sums of one particle's pair terms.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairSum {
@@ -162,19 +171,21 @@ impl<'a> PairModel<'a> {
     }
 
     /// Adds what neighbour `j` contributes to particle `i`'s density rate and acceleration:
-    /// nothing beyond the support 2h, for a coincident pair, or between two walls.
+    /// nothing beyond the support 2h, for a coincident pair, or between two walls. Returns
+    /// the pair's geometry when `i` is mobile and `j` within reach, for the terms of other
+    /// models over the same pair (the stress divergence of the multiphase model).
     #[inline]
-    pub fn add_pair(&self, i: &Side, j: &Side, sum: &mut PairSum) {
+    pub fn add_pair(&self, i: &Side, j: &Side, sum: &mut PairSum) -> Option<PairGeometry> {
         let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
         let r2 = dot3(x_ij, x_ij);
         if r2 >= self.support2 || r2 < self.coincident2 {
-            return;
+            return None;
         }
         let params = self.params;
         let (phase_i, phase_j) = (self.phase(i.phase), self.phase(j.phase));
         // DBC as in DualSPHysics: a wall's density answers to the fluid only.
         if !phase_i.mobile && !phase_j.mobile {
-            return;
+            return None;
         }
         let h = params.h;
         let f = self.kernel.grad_factor(r2.sqrt());
@@ -190,7 +201,7 @@ impl<'a> PairModel<'a> {
         // Continuity, Eq. 9: v_ij . grad_i W_ij = vdotr F.
         sum.drho += m_j * vdotr * f;
         if !phase_i.mobile {
-            return;
+            return None;
         }
         if params.delta > 0.0 && phase_j.mobile && j.phase == i.phase {
             sum.drho += self.delta_h_c0 * self.diffusion(i, j, rho_j, r2, f) * (m_j / rho_j);
@@ -219,6 +230,7 @@ impl<'a> PairModel<'a> {
                 }
             }
         }
+        Some(PairGeometry { x_ij, f, m_j })
     }
 
     /// The density diffusion term psi_ij (before delta h c0 V_j); the hydrostatic density

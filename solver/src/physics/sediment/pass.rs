@@ -24,7 +24,7 @@ use super::suspension::{
 };
 use crate::physics::Params;
 use crate::physics::eos::{pressure, tait_b};
-use crate::physics::interaction::{phase_index, wall_scale};
+use crate::physics::interaction::{PairGeometry, phase_index, wall_scale};
 use crate::physics::kernel::Wendland;
 
 /// The sediment model of one run.
@@ -429,9 +429,15 @@ impl<'a> StressDivergence<'a> {
             phase_j.mass * wall_scale(phases[i.phase as usize].rho0, phase_j.rho0)
         };
         let f = self.kernel.grad_factor(r2.sqrt());
+        Self::add_term(i, j, &PairGeometry { x_ij, f, m_j }, acc);
+    }
+
+    /// The term itself, on a pair whose geometry (`PairModel::add_pair`'s) is known.
+    #[inline]
+    pub fn add_term(i: &StressSide, j: &StressSide, g: &PairGeometry, acc: &mut [f32; 3]) {
         for ((a, t_i), t_j) in acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2) {
-            for ((ti, tj), x) in t_i.iter().zip(t_j).zip(x_ij) {
-                *a += m_j * (ti + tj) * x * f;
+            for ((ti, tj), x) in t_i.iter().zip(t_j).zip(g.x_ij) {
+                *a += g.m_j * (ti + tj) * x * g.f;
             }
         }
     }
