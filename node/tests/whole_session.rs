@@ -1,10 +1,10 @@
 //! The bundled session (`tests/data/ulbra_session.mcap`, 75 s: 2 m3/h, then 2.5 m3/h from
-//! t = 40 s) replayed in-process at CI size to its end. About 18 minutes on a software adapter,
-//! so not in CI yet: `cargo test --release -p flume-twin --test whole_session -- --ignored`.
+//! t = 40 s) replayed in-process at CI size to its end: about 7.5 minutes on two cores, on the
+//! CPU backend (18 on lavapipe).
 
 mod common;
 
-use common::{ULBRA_CI, csv_rows, gpu, python_has, read_mcap, repo_file};
+use common::{ULBRA_CI, csv_rows, python_has, read_mcap, repo_file};
 use serde_json::Value;
 use std::process::Command;
 
@@ -22,9 +22,7 @@ const LEVEL_TOLERANCE_M: f64 = 0.03;
 const STEADY_FROM_S: f64 = 10.0;
 
 #[test]
-#[ignore = "about 18 minutes on lavapipe; run on demand"]
 fn the_bundled_session_replays_to_its_end() {
-    let Some(_gpu) = gpu() else { return };
     if !python_has("mcap_ros2", "mcap mcap-ros2-support") {
         return;
     }
@@ -90,7 +88,9 @@ fn the_bundled_session_replays_to_its_end() {
     assert!(compared > 1000, "only {compared} levels compared");
 
     // The eroded mass stays finite and its rate bounded: at most 0.3 kg/m per second, the
-    // top of the paper's Figure 10 (3 kg/m at 18 s) eroded in 10 s.
+    // top of the paper's Figure 10 (3 kg/m at 18 s) eroded in 10 s, over any 10 s. Over one
+    // row (0.1 s) a single collected particle, 0.271 kg/m at dp = 1 cm, is 2.7 kg/m per
+    // second: the rate is only measurable over many rows.
     let eroded = csv_rows(&csv.join("eroded_mass.csv"));
     let kg_per_m = |r: &std::collections::BTreeMap<String, String>| -> (f64, f64) {
         (
@@ -98,9 +98,13 @@ fn the_bundled_session_replays_to_its_end() {
             r["eroded_kg_per_m"].parse().expect("kg/m"),
         )
     };
-    for w in eroded.windows(2) {
-        let ((t0, m0), (t1, m1)) = (kg_per_m(&w[0]), kg_per_m(&w[1]));
-        assert!(m1.is_finite(), "at {t1} s: {m1}");
+    let rows: Vec<(f64, f64)> = eroded.iter().map(kg_per_m).collect();
+    assert!(rows.iter().all(|(_, m)| m.is_finite()), "a non-finite mass");
+    let window_s = 10.0;
+    for (k, &(t0, m0)) in rows.iter().enumerate() {
+        let Some(&(t1, m1)) = rows[k..].iter().find(|(t, _)| *t >= t0 + window_s - 1e-9) else {
+            break;
+        };
         if t0 >= STEADY_FROM_S {
             assert!(
                 m1 - m0 <= 0.3 * (t1 - t0),
