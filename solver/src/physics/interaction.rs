@@ -174,7 +174,7 @@ impl<'a> PairModel<'a> {
     /// nothing beyond the support 2h, for a coincident pair, or between two walls. Returns
     /// the pair's geometry when `i` is mobile and `j` within reach, for the terms of other
     /// models over the same pair (the stress divergence of the multiphase model).
-    #[inline]
+    #[inline(always)]
     pub fn add_pair(&self, i: &Side, j: &Side, sum: &mut PairSum) -> Option<PairGeometry> {
         let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
         let r2 = dot3(x_ij, x_ij);

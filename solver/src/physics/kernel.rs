@@ -48,7 +48,7 @@ impl Wendland {
     }
 
     /// W of [`w`].
-    #[inline]
+    #[inline(always)]
     pub fn w(&self, r: f32) -> f32 {
         let q = r * self.inv_h;
         if q < 2.0 {
@@ -61,7 +61,7 @@ impl Wendland {
     }
 
     /// F of [`grad_factor`].
-    #[inline]
+    #[inline(always)]
     pub fn grad_factor(&self, r: f32) -> f32 {
         let q = r * self.inv_h;
         if q < 2.0 {

@@ -137,7 +137,7 @@ impl<'a> Release<'a> {
 
     /// Adds neighbour j (position, velocity-density, rheology) to a held particle at `x_i`:
     /// only moving sediment within the support counts.
-    #[inline]
+    #[inline(always)]
     pub fn add_pair(
         &self,
         x_i: &[f32; 4],

@@ -205,7 +205,7 @@ impl<'a> Rheology<'a> {
 
     /// Adds neighbour j to particle i's sums: nothing beyond the support or for a coincident
     /// pair.
-    #[inline]
+    #[inline(always)]
     pub fn add_pair(
         &self,
         (x_i, v_i): (&[f32; 4], &[f32; 4]),
@@ -414,7 +414,7 @@ impl<'a> StressDivergence<'a> {
     }
 
     /// Adds neighbour j's term to mobile particle i's acceleration `acc`.
-    #[inline]
+    #[inline(always)]
     pub fn add_pair(&self, i: &StressSide, j: &StressSide, acc: &mut [f32; 3]) {
         let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
         let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
@@ -433,7 +433,7 @@ impl<'a> StressDivergence<'a> {
     }
 
     /// The term itself, on a pair whose geometry (`PairModel::add_pair`'s) is known.
-    #[inline]
+    #[inline(always)]
     pub fn add_term(i: &StressSide, j: &StressSide, g: &PairGeometry, acc: &mut [f32; 3]) {
         for ((a, t_i), t_j) in acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2) {
             for ((ti, tj), x) in t_i.iter().zip(t_j).zip(g.x_ij) {
