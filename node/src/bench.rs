@@ -8,7 +8,7 @@ use crate::cli::BenchArgs;
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::engine::StageTime;
-use flume_solver::{Backend, Case, GpuContext, Simulation, SolverError};
+use flume_solver::{Backend, Case, GpuContext, Simulation};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -87,8 +87,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         for b in &backends {
             let result = dam_break_case(n).and_then(|case| measure(b, &case, args.steps_seconds));
             match result {
-                Ok(Some(m)) => throughput_row(&mut table, &m),
-                Ok(None) => {}
+                Ok(m) => throughput_row(&mut table, &m),
                 Err(e) => {
                     failures += 1;
                     table.row([format!("~{n}"), "failed".to_string()]);
@@ -107,7 +106,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut measured = Vec::new();
     for b in &backends {
         match measure(b, &reference, args.steps_seconds) {
-            Ok(m) => measured.extend(m),
+            Ok(m) => measured.push(m),
             Err(e) => {
                 failures += 1;
                 println!("error: {e:#}");
@@ -125,7 +124,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     );
     for b in &backends {
         match measure(b, &flume, args.steps_seconds) {
-            Ok(Some(m)) => {
+            Ok(m) => {
                 let mut table = throughput_table();
                 throughput_row(&mut table, &m);
                 print!("{table}");
@@ -137,7 +136,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 );
                 print_stages(&m);
             }
-            Ok(None) => {}
             Err(e) => {
                 failures += 1;
                 println!("error: {e:#}");
@@ -282,18 +280,11 @@ time: {{ end_s: 10.0, output_interval_s: 0.01 }}
         .with_context(|| format!("the synthetic case for {fluid} particles is invalid"))
 }
 
-/// Times `case` on `backend` for about `wall_target_s` after a warm-up; None (and a line
-/// saying why) where the backend does not run the case.
-fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Option<Measurement>> {
+/// Times `case` on `backend` for about `wall_target_s` after a warm-up.
+fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measurement> {
     let name = &case.name;
-    let mut sim = match Simulation::new(backend.clone(), case) {
-        Ok(sim) => sim,
-        Err(SolverError::CpuUnsupported(why)) => {
-            println!("{name}: not timed on the CPU backend, which {why}");
-            return Ok(None);
-        }
-        Err(e) => return Err(e).with_context(|| format!("cannot set up {name}")),
-    };
+    let mut sim =
+        Simulation::new(backend.clone(), case).with_context(|| format!("cannot set up {name}"))?;
     let derived = sim.derived();
     // The acoustic CFL limit: the real step is never larger, so the warm-up is at least 4 steps.
     let dt_guess = case.numerics.cfl * derived.h / derived.c0;
@@ -341,7 +332,7 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Option<
             seconds: now.seconds - before.seconds,
         })
         .collect();
-    Ok(Some(Measurement {
+    Ok(Measurement {
         particles: sim.particle_count() - parked,
         fluid: sim.fluid_count() - parked,
         steps: sim.steps() - steps0,
@@ -350,7 +341,7 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Option<
         start_s,
         backend: sim.backend_name(),
         stages,
-    }))
+    })
 }
 
 #[cfg(test)]

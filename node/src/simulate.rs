@@ -44,7 +44,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         Some(path) => Some(InflowSeries::from_path(path)?),
     };
 
-    let backend = Backend::choose(&case).context("cannot open a backend")?;
+    let backend = Backend::choose().context("cannot open a backend")?;
     let mut sim = Simulation::new(backend, &case).context("cannot set up the simulation")?;
     println!("adapter: {}", sim.backend_name());
     print_case(&args.case, &case, &sim);

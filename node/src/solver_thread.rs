@@ -78,7 +78,7 @@ pub fn spawn(
         .name("flume-solver".into())
         .spawn(move || {
             let started = (|| -> Result<(Backend, Simulation, Option<Recorder>)> {
-                let backend = Backend::choose(&case).context("cannot open a backend")?;
+                let backend = Backend::choose().context("cannot open a backend")?;
                 let sim = Simulation::new(backend.clone(), &case)
                     .context("cannot set up the simulation")?;
                 let recorder = match &out {

@@ -2,7 +2,6 @@
 //! backend; `FLUME_TWIN_ADAPTER` forces either (`cpu`, or any part of an adapter's name, such
 //! as `llvmpipe` for lavapipe).
 
-use crate::config::Case;
 use crate::gpu::context::ADAPTER_ENV;
 use crate::gpu::{GpuContext, GpuError};
 use std::sync::Arc;
@@ -37,30 +36,21 @@ impl std::fmt::Debug for Backend {
 }
 
 impl Backend {
-    /// The backend for `case`: the one `FLUME_TWIN_ADAPTER` names, else a real (not software)
-    /// GPU, else the CPU backend where it runs the case, else the best software adapter.
-    pub fn choose(case: &Case) -> Result<Backend, GpuError> {
+    /// The backend `FLUME_TWIN_ADAPTER` names, else a real (not software) GPU, else the CPU
+    /// backend (faster than a software adapter on the same cores).
+    pub fn choose() -> Result<Backend, GpuError> {
         let wanted = std::env::var(ADAPTER_ENV).ok().filter(|s| !s.is_empty());
         match wanted.as_deref() {
             Some(w) if w.eq_ignore_ascii_case(CPU_BACKEND) => Ok(Backend::Cpu { threads: 0 }),
             Some(w) => Ok(Backend::Gpu(Arc::new(GpuContext::with_adapter(Some(w))?))),
-            None => Self::best(case),
+            None => Ok(Self::best()),
         }
     }
 
-    fn best(case: &Case) -> Result<Backend, GpuError> {
-        let gpu = GpuContext::with_adapter(None);
-        if let Ok(g) = &gpu
-            && !g.is_software()
-        {
-            return gpu.map(|g| Backend::Gpu(Arc::new(g)));
-        }
-        match crate::cpu::unsupported(case) {
-            None => Ok(Backend::Cpu { threads: 0 }),
-            Some(why) => {
-                log::info!("the CPU backend {why}: running on a wgpu adapter");
-                gpu.map(|g| Backend::Gpu(Arc::new(g)))
-            }
+    fn best() -> Backend {
+        match GpuContext::with_adapter(None) {
+            Ok(g) if !g.is_software() => Backend::Gpu(Arc::new(g)),
+            _ => Backend::Cpu { threads: 0 },
         }
     }
 

@@ -59,8 +59,8 @@ pub enum SolverError {
         density_error: f64,
         c0_needed_m_per_s: f64,
     },
-    #[error("the CPU backend {0}; run it on a GPU adapter (unset FLUME_TWIN_ADAPTER, or name one)")]
-    CpuUnsupported(String),
+    #[error("the CPU backend cannot start its threads: {0}")]
+    CpuThreads(String),
     #[error("parameter `{name}` refused: {reason}")]
     InvalidParameter { name: &'static str, reason: String },
 }
@@ -217,20 +217,15 @@ impl Simulation {
                 &probes.points,
                 shape,
             )?),
-            Backend::Cpu { threads } => {
-                if let Some(why) = crate::cpu::unsupported(case) {
-                    return Err(SolverError::CpuUnsupported(why));
-                }
-                Box::new(crate::cpu::CpuEngine::new(
-                    threads,
-                    &params,
-                    derived.phases.len(),
-                    crate::uniform::sediment_model(case, &derived),
-                    &particles,
-                    &probes.points,
-                    shape,
-                )?)
-            }
+            Backend::Cpu { threads } => Box::new(crate::cpu::CpuEngine::new(
+                threads,
+                &params,
+                derived.phases.len(),
+                crate::uniform::sediment_model(case, &derived),
+                &particles,
+                &probes.points,
+                shape,
+            )?),
         };
         let flume = FlumeState::new(case, &particles);
         let max_excluded = health::max_excluded_per_chunk(

@@ -16,7 +16,6 @@ mod step;
 mod store;
 
 use crate::case::Particles;
-use crate::config::Case;
 use crate::engine::{Engine, RawState, StageTime};
 use crate::gpu::engine::{PipelineShape, by_id};
 use crate::gpu::params::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
@@ -25,12 +24,6 @@ use crate::physics::sediment::pass::SedimentModel;
 use crate::physics::sediment::suspension::Region;
 use crate::simulation::SolverError;
 use grid::Grid;
-
-/// Why the CPU backend cannot run `case`, or None when it can. It runs them all; the choice of
-/// backend asks, so that a case it could not run would go to a wgpu adapter.
-pub fn unsupported(_case: &Case) -> Option<String> {
-    None
-}
 
 /// The line naming the CPU backend on `threads` threads (0: one per core).
 pub fn describe(threads: usize) -> String {
@@ -104,7 +97,7 @@ impl CpuEngine {
             .num_threads(threads)
             .thread_name(|k| format!("flume-cpu-{k}"))
             .build()
-            .map_err(|e| SolverError::CpuUnsupported(format!("cannot start its threads: {e}")))?;
+            .map_err(|e| SolverError::CpuThreads(e.to_string()))?;
         let a = State {
             positions: particles.positions.clone(),
             vel_rho: particles.vel_rho.clone(),
