@@ -3,7 +3,7 @@
 //! cell list, particles shared out among threads in blocks. Each sum is taken by one thread in
 //! sorted order, so the result does not depend on the number of threads.
 
-use super::grid::Grid;
+use super::neighbours::Neighbourhood;
 use crate::physics::interaction::{PairModel, PairSum, Side};
 use crate::physics::sediment::pass::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
@@ -15,21 +15,21 @@ const BLOCK: usize = 512;
 
 /// What the force pass reads besides the particles' sides.
 pub struct Extra<'a> {
-    /// The multiphase model's stress side and apparent viscosity of each particle (its
-    /// explicit viscous bound joins the step).
-    pub stress: Option<(&'a [StressSide], &'a [f32])>,
+    /// The multiphase model's stress divergence, with the stress side and apparent viscosity
+    /// of each particle (its explicit viscous bound joins the step).
+    pub stress: Option<(&'a StressDivergence<'a>, &'a [StressSide], &'a [f32])>,
     /// Particles whose velocity is imposed (an open flume's inlet buffer and duct): their
     /// acceleration does not bound the step. Empty: none.
     pub imposed: &'a [bool],
 }
 
 /// Fills `forces` (`[ax, ay, az, d rho/dt]`) and `dt_limit` (the stable step before the CFL
-/// factor) of each particle of `sides`, in sorted order; cells come from `grid`, whose
-/// starts were sorted from the same particles or from the state half a step before.
+/// factor) of each particle of `sides`, in sorted order, over the neighbours `near` gives
+/// (cells sorted from the same particles or from the state half a step before).
 pub fn force_pass(
     pool: &rayon::ThreadPool,
     model: &PairModel,
-    grid: &Grid,
+    near: &impl Neighbourhood,
     sides: &[Side],
     extra: &Extra,
     forces: &mut [[f32; 4]],
@@ -48,28 +48,22 @@ pub fn force_pass(
                     let side = &sides[i];
                     let mut sum = PairSum::default();
                     let mut tau = [0.0f32; 3];
-                    grid.rows(grid.coords(&side.x), |range| match extra.stress {
-                        None => {
-                            for j in range {
-                                model.add_pair(side, &sides[j], &mut sum);
+                    match extra.stress {
+                        None => near.visit(i, &side.x, |j| {
+                            model.add_pair(side, &sides[j], &mut sum);
+                        }),
+                        Some((div, stress, _)) => near.visit(i, &side.x, |j| {
+                            if let Some(g) = model.add_pair(side, &sides[j], &mut sum) {
+                                div.add_term(&stress[i], &stress[j], &g, &mut tau);
                             }
-                        }
-                        Some((stress, _)) => {
-                            for j in range {
-                                if let Some(g) = model.add_pair(side, &sides[j], &mut sum) {
-                                    StressDivergence::add_term(
-                                        &stress[i], &stress[j], &g, &mut tau,
-                                    );
-                                }
-                            }
-                        }
-                    });
+                        }),
+                    }
                     for (a, t) in sum.acc.iter_mut().zip(tau) {
                         *a += t;
                     }
                     let imposed = extra.imposed.get(i).copied().unwrap_or(false);
                     (*f, *dt) = model.finish(side, &sum, !imposed);
-                    if let Some((_, mu)) = extra.stress
+                    if let Some((_, _, mu)) = extra.stress
                         && dt.is_finite()
                     {
                         *dt = dt.min(particle_viscous_bound(h, side.rho, mu[i]));

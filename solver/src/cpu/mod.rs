@@ -11,6 +11,7 @@
 mod forces;
 mod grid;
 mod multiphase;
+mod neighbours;
 mod observe;
 mod step;
 mod store;
@@ -59,12 +60,14 @@ impl State {
     }
 }
 
-/// The stages timed apart, in step order; "rheology" includes the release of held sand.
-const STAGES: [&str; 4] = ["sort", "rheology", "forces", "integrate"];
+/// The stages timed apart, in step order; "neighbours" is the list of pairs the
+/// water-sediment model's passes share, "rheology" includes the release of held sand.
+const STAGES: [&str; 5] = ["sort", "neighbours", "rheology", "forces", "integrate"];
 const STAGE_SORT: usize = 0;
-const STAGE_RHEOLOGY: usize = 1;
-const STAGE_FORCES: usize = 2;
-const STAGE_INTEGRATE: usize = 3;
+const STAGE_NEIGHBOURS: usize = 1;
+const STAGE_RHEOLOGY: usize = 2;
+const STAGE_FORCES: usize = 3;
+const STAGE_INTEGRATE: usize = 4;
 
 pub struct CpuEngine {
     pool: rayon::ThreadPool,
@@ -80,7 +83,7 @@ pub struct CpuEngine {
     snapshot: (State, Vec<u32>),
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
-    seconds: [f64; 4],
+    seconds: [f64; STAGES.len()],
 }
 
 impl CpuEngine {
@@ -116,7 +119,7 @@ impl CpuEngine {
             a,
             regions,
             probe_points: probe_points.to_vec(),
-            seconds: [0.0; 4],
+            seconds: [0.0; STAGES.len()],
         })
     }
 

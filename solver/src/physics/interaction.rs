@@ -48,13 +48,15 @@ fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
 }
 
 /// One particle as its pairs see it: position, velocity, density, the pressure of the momentum
-/// equation over rho^2 and its phase index.
+/// equation over rho^2, its volume m / rho and its phase index. What depends on the particle
+/// alone is worked out here, once, rather than in each of its some forty pairs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Side {
     pub x: [f32; 3],
     pub v: [f32; 3],
     pub rho: f32,
     pub p_over_rho2: f32,
+    pub vol: f32,
     pub phase: u32,
 }
 
@@ -162,6 +164,7 @@ impl<'a> PairModel<'a> {
             v: [vel_rho[0], vel_rho[1], vel_rho[2]],
             rho,
             p_over_rho2: self.pressure(rho, phase) / (rho * rho),
+            vol: self.phase(phase as u32).mass / rho,
             phase: phase as u32,
         }
     }
@@ -203,12 +206,15 @@ impl<'a> PairModel<'a> {
         if !phase_i.mobile {
             return None;
         }
+        // One division for the two terms over r^2 + eta^2.
+        let inv_r2_eta2 = 1.0 / (r2 + self.eta2);
         if params.delta > 0.0 && phase_j.mobile && j.phase == i.phase {
-            sum.drho += self.delta_h_c0 * self.diffusion(i, j, rho_j, r2, f) * (m_j / rho_j);
+            // Same phase, not a wall: j's own mass and density, hence its own volume.
+            sum.drho += self.delta_h_c0 * self.diffusion(i, j, r2, f, inv_r2_eta2) * j.vol;
         }
         // Pressure gradient, Eq. 10 with sigma = -p I.
         let mut coef = -m_j * (i.p_over_rho2 + p_j);
-        let mu_ij = h * vdotr / (r2 + self.eta2);
+        let mu_ij = h * vdotr * inv_r2_eta2;
         sum.visc_max = sum.visc_max.max(mu_ij.abs());
         match params.viscosity {
             Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } => {
@@ -223,8 +229,7 @@ impl<'a> PairModel<'a> {
             }
             Viscosity::Laminar => {
                 // x_ij . grad_i W_ij = r2 F.
-                let s =
-                    m_j * (phase_i.mu + phase_j.mu) * (r2 * f) / (i.rho * rho_j * (r2 + self.eta2));
+                let s = m_j * (phase_i.mu + phase_j.mu) * (r2 * f) * inv_r2_eta2 / (i.rho * rho_j);
                 for k in 0..3 {
                     sum.acc[k] += coef * f * x_ij[k] + s * v_ij[k];
                 }
@@ -237,7 +242,9 @@ impl<'a> PairModel<'a> {
     /// difference rho_h is subtracted so that a fluid at rest under gravity is not diffused
     /// towards uniform density. rho_h = rho0 ((1 + x)^(1/7) - 1), x = rho0 g dz / B, by its
     /// series: x is below 1e-3 for neighbours (dz < 2h), where three terms are exact in f32.
-    fn diffusion(&self, i: &Side, j: &Side, rho_j: f32, r2: f32, f: f32) -> f32 {
+    /// `inv_r2_eta2` is 1 / (r^2 + eta^2).
+    #[inline(always)]
+    fn diffusion(&self, i: &Side, j: &Side, r2: f32, f: f32, inv_r2_eta2: f32) -> f32 {
         let rho_h = if self.params.hydrostatic_diffusion {
             let phase = self.phase(i.phase);
             let rho0 = phase.rho0;
@@ -246,7 +253,7 @@ impl<'a> PairModel<'a> {
         } else {
             0.0
         };
-        2.0 * (rho_j - i.rho - rho_h) * (-r2 * f) / (r2 + self.eta2)
+        2.0 * (j.rho - i.rho - rho_h) * (-r2 * f) * inv_r2_eta2
     }
 
     /// Particle `i`'s `[ax, ay, az, d rho/dt]` (gravity added; zero acceleration for a wall)

@@ -203,13 +203,31 @@ impl<'a> Rheology<'a> {
         s
     }
 
+    /// The volume m / rho of particle `x`, `v` (a neighbour's weight in every sum).
+    pub fn volume(&self, x: &[f32; 4], v: &[f32; 4]) -> f32 {
+        self.params.phases[phase_index(x)].mass / v[3]
+    }
+
     /// Adds neighbour j to particle i's sums: nothing beyond the support or for a coincident
     /// pair.
     #[inline(always)]
     pub fn add_pair(
         &self,
+        i: (&[f32; 4], &[f32; 4]),
+        j: (&[f32; 4], &[f32; 4]),
+        s: &mut RheologySums,
+    ) {
+        self.add_pair_of_volume(i, j, self.volume(j.0, j.1), s);
+    }
+
+    /// [`Rheology::add_pair`] with the neighbour's volume `vol_j` ([`Rheology::volume`])
+    /// worked out beforehand, once per particle rather than once per pair.
+    #[inline(always)]
+    pub fn add_pair_of_volume(
+        &self,
         (x_i, v_i): (&[f32; 4], &[f32; 4]),
         (x_j, v_j): (&[f32; 4], &[f32; 4]),
+        vol_j: f32,
         s: &mut RheologySums,
     ) {
         let x_ij = sub3(x_i, x_j);
@@ -219,13 +237,15 @@ impl<'a> Rheology<'a> {
         }
         let pj = phase_index(x_j);
         let m_j = self.params.phases[pj].mass;
-        let vol_j = m_j / v_j[3];
         let r = r2.sqrt();
         let f = self.kernel.grad_factor(r);
         let du = sub3(v_j, v_i);
-        for (row, d) in s.grad.iter_mut().zip(du) {
-            for (g, x) in row.iter_mut().zip(x_ij) {
-                *g += vol_j * d * x * f;
+        // In 2-D the third row and column are zero: the loops stop at the dimension.
+        let dim = self.params.dim as usize;
+        let weight = vol_j * f;
+        for (row, d) in s.grad.iter_mut().zip(du).take(dim) {
+            for (g, x) in row.iter_mut().zip(x_ij).take(dim) {
+                *g += weight * d * x;
             }
         }
         let model = self.model;
@@ -429,15 +449,19 @@ impl<'a> StressDivergence<'a> {
             phase_j.mass * wall_scale(phases[i.phase as usize].rho0, phase_j.rho0)
         };
         let f = self.kernel.grad_factor(r2.sqrt());
-        Self::add_term(i, j, &PairGeometry { x_ij, f, m_j }, acc);
+        self.add_term(i, j, &PairGeometry { x_ij, f, m_j }, acc);
     }
 
     /// The term itself, on a pair whose geometry (`PairModel::add_pair`'s) is known.
     #[inline(always)]
-    pub fn add_term(i: &StressSide, j: &StressSide, g: &PairGeometry, acc: &mut [f32; 3]) {
-        for ((a, t_i), t_j) in acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2) {
-            for ((ti, tj), x) in t_i.iter().zip(t_j).zip(g.x_ij) {
-                *a += g.m_j * (ti + tj) * x * g.f;
+    pub fn add_term(&self, i: &StressSide, j: &StressSide, g: &PairGeometry, acc: &mut [f32; 3]) {
+        // In 2-D the third row and column are zero: the loops stop at the dimension.
+        let dim = self.params.dim as usize;
+        let weight = g.m_j * g.f;
+        let rows = acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2);
+        for ((a, t_i), t_j) in rows.take(dim) {
+            for ((ti, tj), x) in t_i.iter().zip(t_j).zip(g.x_ij).take(dim) {
+                *a += weight * (ti + tj) * x;
             }
         }
     }
