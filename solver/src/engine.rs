@@ -4,7 +4,7 @@
 //! time keeping, recovery, the open flume's host side and observations stay in one place.
 
 use crate::gpu::params::{Extremes, SimParams, StepState};
-use crate::simulation::SolverError;
+use crate::error::SolverError;
 
 /// The state as the backend stores it: positions, velocity-density and ids, each in the
 /// backend's own order (the cell order of the last step).

@@ -9,7 +9,7 @@
 
 use crate::case::{self, Particles};
 use crate::config::{Case, OpenFlume};
-use crate::simulation::SolverError;
+use crate::error::SolverError;
 
 /// The discharge driving the inlet, m3/s; set at any time with
 /// `Simulation::set_boundary_conditions`.

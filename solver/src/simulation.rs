@@ -7,63 +7,16 @@ use crate::backend::Backend;
 use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, Integrator, Viscosity, YieldCriterion};
 use crate::engine::{Engine, StageTime};
+use crate::error::SolverError;
 use crate::flume::{
     BoundaryConditions, FlumeState, MAX_INLET_MACH, max_inflow_m3_per_s, parked_slots,
 };
-use crate::gpu::GpuError;
 use crate::gpu::engine::{GpuEngine, PipelineShape, by_id};
 use crate::gpu::params::*;
 use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
 use crate::uniform::{inlet_velocity, sim_params};
-
-#[derive(Debug, thiserror::Error)]
-pub enum SolverError {
-    #[error(transparent)]
-    Gpu(#[from] GpuError),
-    #[error("the case has {0} particles; the solver's indices are 32-bit")]
-    TooManyParticles(u64),
-    #[error(
-        "the case's neighbour grid has {0} cells; the solver's cell indices are 32-bit: use a coarser dp or a smaller domain"
-    )]
-    TooManyCells(u64),
-    #[error(
-        "simulation blew up at t = {time_s:.6} s (step {step}): {health}{}; worst particles: {}",
-        recurring_cfl.map_or(String::new(), |c| format!(
-            "; it recurred at about the same simulated time at every CFL down to {}: not a time-step problem",
-            c as f32
-        )),
-        health::list(culprits)
-    )]
-    BlowUp {
-        time_s: f64,
-        step: u64,
-        health: Health,
-        /// The particles furthest from health when it failed (excluded ones first), worst first.
-        culprits: Vec<Culprit>,
-        /// The CFL number of a retry that failed at the same simulated time as the try before.
-        recurring_cfl: Option<f64>,
-    },
-    #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
-    TimeGoesBack { target_s: f64, now_s: f64 },
-    #[error(
-        "c0 = {c0_m_per_s:.3} m/s is too low for fluid {fluid_height_m} m high: at rest its density \
-         is already {:.1} % off rest density (the bound is 10 %); use c0 above {c0_needed_m_per_s:.2} m/s \
-         (coefsound 10 or more is usual)",
-        100.0 * density_error
-    )]
-    SoundSpeedTooLow {
-        c0_m_per_s: f64,
-        fluid_height_m: f64,
-        density_error: f64,
-        c0_needed_m_per_s: f64,
-    },
-    #[error("the CPU backend cannot start its threads: {0}")]
-    CpuThreads(String),
-    #[error("parameter `{name}` refused: {reason}")]
-    InvalidParameter { name: &'static str, reason: String },
-}
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.

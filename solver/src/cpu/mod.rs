@@ -22,7 +22,7 @@ use crate::gpu::params::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
 use crate::physics;
 use crate::physics::sediment::pass::SedimentModel;
 use crate::physics::sediment::suspension::Region;
-use crate::simulation::SolverError;
+use crate::error::SolverError;
 use grid::Grid;
 
 /// The line naming the CPU backend on `threads` threads (0: one per core).

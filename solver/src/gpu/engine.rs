@@ -7,7 +7,7 @@ use super::params::{Extremes, SimParams, StepState};
 use crate::case::Particles;
 use crate::engine::{Engine, RawState, StageTime};
 use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
-use crate::simulation::SolverError;
+use crate::error::SolverError;
 use std::sync::Arc;
 
 /// Which optional stages a case's pipeline has.
