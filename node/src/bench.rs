@@ -347,7 +347,8 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measure
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flume_solver::case::{WALL_PHASE, derive, generate};
+    use flume_solver::particles::WALL_PHASE;
+    use flume_solver::{derive, generate};
     use std::path::Path;
 
     /// Fluid particles a case holds, counted on the CPU.

@@ -10,8 +10,8 @@
 //! are removed when the twin starts.
 
 use anyhow::{Context, Result, anyhow};
+use flume_solver::Particles;
 use flume_solver::Simulation;
-use flume_solver::case::Particles;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::prelude::*;

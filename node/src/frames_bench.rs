@@ -103,7 +103,7 @@ pub fn run(case_path: &std::path::Path, seconds: f64) -> Result<()> {
     let parked = case
         .open_flume
         .as_ref()
-        .map_or(0, |_| flume_solver::case::parked_phase(&case));
+        .map_or(0, |_| flume_solver::particles::parked_phase(&case));
     let mut frames = Frames::open(&service, count, parked, f64::INFINITY)?;
     let particles = sim
         .read_particles()

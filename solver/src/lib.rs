@@ -6,15 +6,18 @@
 //! in `shaders/stages/`, its spec in `stages.rs` and its CPU oracle in `physics`.
 
 pub mod backend;
-pub mod case;
 pub mod config;
 pub mod cpu;
+pub mod derived;
 pub mod engine;
 pub mod error;
 pub mod flume;
+pub mod generate;
 pub mod gpu;
 pub mod health;
+mod load;
 pub mod observe;
+pub mod particles;
 pub mod physics;
 pub mod pipeline;
 pub mod simulation;
@@ -23,8 +26,11 @@ pub mod uniform;
 
 pub use backend::Backend;
 pub use config::{Case, ConfigError};
+pub use derived::{MAX_INLET_MACH, check_inflow, derive};
+pub use error::SolverError;
 pub use flume::BoundaryConditions;
+pub use generate::generate;
 pub use gpu::{GpuContext, GpuError};
 pub use observe::{Observations, ProfileColumn};
-pub use error::SolverError;
+pub use particles::Particles;
 pub use simulation::{Health, Recovery, Simulation};

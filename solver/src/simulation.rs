@@ -4,18 +4,18 @@
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s).
 
 use crate::backend::Backend;
-use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, Integrator, Viscosity, YieldCriterion};
+use crate::derived::{Derived, MAX_INLET_MACH, check_inflow, derive, max_inflow_m3_per_s};
 use crate::engine::{Engine, StageTime};
 use crate::error::SolverError;
-use crate::flume::{
-    BoundaryConditions, FlumeState, MAX_INLET_MACH, max_inflow_m3_per_s, parked_slots,
-};
+use crate::flume::{BoundaryConditions, FlumeState, parked_slots};
+use crate::generate::{count, generate};
 use crate::gpu::engine::{GpuEngine, PipelineShape, by_id};
 use crate::gpu::params::*;
 use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
+use crate::particles::{Parking, Particles, SPLASH_ROOM, WALL_PHASE};
 use crate::uniform::{inlet_velocity, sim_params};
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
@@ -73,9 +73,9 @@ fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverE
         let mut hi = case.domain.max_m[k] + margin;
         if k == d - 1 {
             // Room above the tank for splashes; particles above the grid still live in its top row.
-            hi += case::SPLASH_ROOM * (case.domain.max_m[k] - case.domain.min_m[k]);
+            hi += SPLASH_ROOM * (case.domain.max_m[k] - case.domain.min_m[k]);
             if case.open_flume.is_some() {
-                hi = hi.max(case::Parking::new(case, h).top(n) + margin);
+                hi = hi.max(Parking::new(case, h).top(n) + margin);
             }
         }
         dims[k] = ((hi - lo) / cell).ceil().clamp(1.0, f64::from(u32::MAX)) as u32;
@@ -94,8 +94,8 @@ fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverE
 impl Simulation {
     pub fn new(backend: impl Into<Backend>, case: &Case) -> Result<Simulation, SolverError> {
         let backend = backend.into();
-        let derived = case::derive(case);
-        let count = case::count(case);
+        let derived = derive(case);
+        let count = count(case);
         let (grid_dims, _) = grid_for(case, derived.h, count)?;
         let n_cells = u64::from(grid_dims[3]);
         // Particle indices are u32 on the GPU, with headroom for index arithmetic.
@@ -105,8 +105,8 @@ impl Simulation {
         if let Backend::Gpu(gpu) = &backend {
             crate::pipeline::GpuBuffers::check_limits(gpu, count, n_cells)?;
         }
-        crate::flume::check_inflow(case)?;
-        let particles = case::generate(case, &derived);
+        check_inflow(case)?;
+        let particles = generate(case, &derived);
         // A sound speed too low for the fluid's height starts outside the weakly compressible
         // range: say so now, not as a blow-up at the first step.
         let worst = (0..particles.len())
@@ -137,7 +137,7 @@ impl Simulation {
         case: &Case,
         particles: Particles,
     ) -> Result<Simulation, SolverError> {
-        let derived = case::derive(case);
+        let derived = derive(case);
         let (grid_dims, grid_origin) = grid_for(case, derived.h, particles.len() as u64)?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);

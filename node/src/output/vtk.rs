@@ -5,7 +5,7 @@
 //! Legacy binary VTK is big-endian whatever the machine, and the points are always 3-D
 //! (z = 0 in a 2-D case) because readers have no 2-D point type.
 
-use flume_solver::case::Particles;
+use flume_solver::Particles;
 use std::io::{self, Write};
 
 /// Writes `particles` as one vertex cell per particle with velocity, density, phase, region,
