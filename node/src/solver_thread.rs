@@ -106,10 +106,7 @@ pub fn spawn(
                 }
             }
             let mut k = 0;
-            let parked = case
-                .open_flume
-                .as_ref()
-                .map(|_| flume_solver::particles::parked_phase(&case));
+            let parked = sim.parked_phase();
             let mut frames = frames.and_then(|f| {
                 match Frames::open(
                     &f.service,

@@ -15,7 +15,7 @@ use crate::gpu::params::*;
 use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
-use crate::particles::{Parking, Particles, SPLASH_ROOM, WALL_PHASE};
+use crate::particles::{Parking, ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
 use crate::uniform::{inlet_velocity, sim_params};
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
@@ -110,7 +110,7 @@ impl Simulation {
         // A sound speed too low for the fluid's height starts outside the weakly compressible
         // range: say so now, not as a blow-up at the first step.
         let worst = (0..particles.len())
-            .filter(|&i| particles.phase(i) != WALL_PHASE)
+            .filter(|&i| !particles.is_wall(i))
             .map(|i| {
                 let rho0 = derived.phases[particles.phase(i) as usize].rho0;
                 (f64::from(particles.vel_rho[i][3]) / rho0 - 1.0).abs()
@@ -183,7 +183,7 @@ impl Simulation {
         let flume = FlumeState::new(case, &particles);
         let max_excluded = health::max_excluded_per_chunk(
             (0..particles.len())
-                .filter(|&i| particles.phase(i) != WALL_PHASE)
+                .filter(|&i| !particles.is_wall(i))
                 .count(),
         );
         Ok(Simulation {
@@ -227,8 +227,13 @@ impl Simulation {
     /// Particles that are not walls (parked ones included: they are water out of the flow).
     pub fn fluid_count(&self) -> usize {
         (0..self.initial_particles.len())
-            .filter(|&i| self.initial_particles.phase(i) != WALL_PHASE)
+            .filter(|&i| !self.initial_particles.is_wall(i))
             .count()
+    }
+    /// The phase code of parked particles, for readers of particle frames; none in a closed
+    /// tank, which parks none.
+    pub fn parked_phase(&self) -> Option<u32> {
+        self.flume.as_ref().map(|_| parked_phase(&self.case))
     }
     pub fn time_s(&self) -> f64 {
         self.time_s
@@ -617,7 +622,7 @@ impl Simulation {
         if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
             let mut counts = [0u32; 6];
             for w in self.regions()? {
-                counts[((w & 255) as usize).min(5)] += 1;
+                counts[usize::from(ParticleRegion::from_word(w).number())] += 1;
             }
             obs.region_counts = Some(counts);
         }

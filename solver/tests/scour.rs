@@ -36,7 +36,7 @@ fn assert_nothing_leaks(
     sim: &Simulation,
     start: &Particles,
     now: &Particles,
-    f: &flume_solver::observe::FlumeObservation,
+    f: &flume_solver::FlumeObservation,
 ) {
     assert_eq!(now.len(), start.len(), "the particle count changed");
     let mass = |p: &Particles| -> f64 {
