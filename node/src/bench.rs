@@ -7,7 +7,7 @@
 use crate::cli::BenchArgs;
 use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
-use flume_solver::engine::StageTime;
+use flume_solver::StageTime;
 use flume_solver::{Backend, Case, GpuContext, Simulation};
 use std::sync::Arc;
 use std::time::Instant;
@@ -154,8 +154,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 /// The backends to time: the CPU backend, and the wgpu adapter when there is one, unless
 /// `FLUME_TWIN_ADAPTER` names one of them.
 fn backends() -> Result<Vec<Backend>> {
-    let wanted = std::env::var(flume_solver::gpu::context::ADAPTER_ENV).unwrap_or_default();
-    if wanted.eq_ignore_ascii_case(flume_solver::backend::CPU_BACKEND) {
+    let wanted = std::env::var(flume_solver::ADAPTER_ENV).unwrap_or_default();
+    if wanted.eq_ignore_ascii_case(flume_solver::CPU_BACKEND) {
         return Ok(vec![Backend::Cpu { threads: 0 }]);
     }
     if !wanted.is_empty() {
@@ -347,14 +347,14 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measure
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flume_solver::case::{WALL_PHASE, derive, generate};
+    use flume_solver::{derive, generate};
     use std::path::Path;
 
     /// Fluid particles a case holds, counted on the CPU.
     fn fluid_of(case: &Case) -> usize {
         let particles = generate(case, &derive(case));
         (0..particles.len())
-            .filter(|&i| particles.phase(i) != WALL_PHASE)
+            .filter(|&i| !particles.is_wall(i))
             .count()
     }
 

@@ -10,8 +10,7 @@
 //! are removed when the twin starts.
 
 use anyhow::{Context, Result, anyhow};
-use flume_solver::Simulation;
-use flume_solver::case::Particles;
+use flume_solver::{ParticleRegion, Particles, Simulation};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::prelude::*;
@@ -189,14 +188,14 @@ impl Frames {
         self.buffer.extend((0..p.len()).map(|i| {
             let [x, y, z, _] = p.positions[i];
             let [u, v, w, rho] = p.vel_rho[i];
+            let region = ParticleRegion::from_word(regions[i]);
             Particle {
                 position: in_flume_frame(two_d, [x, y, z]),
                 velocity: in_flume_frame(two_d, [u, v, w]),
                 density: rho,
                 phase: u8::try_from(p.phase(i)).unwrap_or(u8::MAX),
-                // The solver's region word: the region in the low byte, 256 when held.
-                region: (regions[i] & 255) as u8,
-                held: ((regions[i] >> 8) & 1) as u8,
+                region: region.number(),
+                held: u8::from(region.held),
                 reserved: 0,
             }
         }));

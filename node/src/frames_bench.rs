@@ -100,10 +100,7 @@ pub fn run(case_path: &std::path::Path, seconds: f64) -> Result<()> {
         .with_context(|| format!("cannot set up {}", case.name))?;
     let count = sim.particle_count();
     let service = format!("flume_twin/bench_frames_{}", std::process::id());
-    let parked = case
-        .open_flume
-        .as_ref()
-        .map_or(0, |_| flume_solver::case::parked_phase(&case));
+    let parked = sim.parked_phase().unwrap_or(0);
     let mut frames = Frames::open(&service, count, parked, f64::INFINITY)?;
     let particles = sim
         .read_particles()

@@ -91,11 +91,10 @@ pub struct Limits {
 impl Limits {
     /// The limits of `case`'s open flume (none on the discharge without one).
     pub fn for_case(case: &flume_solver::Case, future_tolerance_s: f64) -> Limits {
-        let derived = flume_solver::case::derive(case);
         let vertical = case.dim() - 1;
         Limits {
             max_discharge_m3_per_s: case.open_flume.as_ref().map_or(f64::INFINITY, |f| {
-                flume_solver::flume::MAX_INLET_MACH * derived.c0 * f.inlet.height_m * f.width_m
+                flume_solver::max_inflow_m3_per_s(f, flume_solver::derive(case).c0)
             }),
             flume_height_m: case.domain.max_m[vertical] - case.domain.min_m[vertical],
             future_tolerance_s,

@@ -11,7 +11,7 @@ fn nan_if_none(v: Option<f64>) -> f64 {
 }
 
 pub fn bed_profile(obs: &Observations, header: Header) -> BedProfile {
-    let bed = |f: fn(&flume_solver::observe::BedInterfaces) -> Option<f64>| -> Vec<f64> {
+    let bed = |f: fn(&flume_solver::BedInterfaces) -> Option<f64>| -> Vec<f64> {
         obs.profile
             .iter()
             .map(|c| nan_if_none(c.bed.as_ref().and_then(f)))

@@ -21,7 +21,7 @@ fn passes_a_quarter(before_s: f64, t_s: f64, end_s: f64) -> bool {
 pub fn run(args: &SimulateArgs) -> Result<()> {
     // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
     let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
-    flume_solver::flume::check_inflow(&case).context("the case file was refused")?;
+    flume_solver::check_inflow(&case).context("the case file was refused")?;
     let end_s = match args.until {
         Some(t) if !(t.is_finite() && t > 0.0) => {
             bail!("--until must be a positive time in s, got {t}")

@@ -5,7 +5,7 @@ use crate::frames::{Frames, in_flume_frame};
 use crate::output::recorder::Recorder;
 use crate::visual::CloudPoint;
 use anyhow::{Context, Result};
-use flume_solver::case::Particles;
+use flume_solver::Particles;
 use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation};
 use std::path::PathBuf;
 use std::sync::mpsc;
@@ -106,10 +106,7 @@ pub fn spawn(
                 }
             }
             let mut k = 0;
-            let parked = case
-                .open_flume
-                .as_ref()
-                .map(|_| flume_solver::case::parked_phase(&case));
+            let parked = sim.parked_phase();
             let mut frames = frames.and_then(|f| {
                 match Frames::open(
                     &f.service,

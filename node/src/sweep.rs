@@ -7,7 +7,7 @@ use crate::output::{csv::field, sweep_plot};
 use crate::progress;
 use crate::table::{Table, sig};
 use anyhow::{Context, Result, bail};
-use flume_solver::observe::FlumeObservation;
+use flume_solver::FlumeObservation;
 use flume_solver::{Case, GpuContext, Simulation};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

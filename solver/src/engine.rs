@@ -3,8 +3,8 @@
 //! the same order on the same uniform (`SimParams`) and the same step state (`StepState`), so
 //! time keeping, recovery, the open flume's host side and observations stay in one place.
 
+use crate::error::SolverError;
 use crate::gpu::params::{Extremes, SimParams, StepState};
-use crate::simulation::SolverError;
 
 /// The state as the backend stores it: positions, velocity-density and ids, each in the
 /// backend's own order (the cell order of the last step).

@@ -7,49 +7,14 @@
 //! takes no part in the flow. Each time the inlet buffer has moved one dp, the host fills a new
 //! column behind it with parked particles, lowest id first, so that runs stay deterministic.
 
-use crate::case::{self, Particles};
 use crate::config::{Case, OpenFlume};
-use crate::simulation::SolverError;
+use crate::particles::{Particles, parked_phase};
 
 /// The discharge driving the inlet, m3/s; set at any time with
 /// `Simulation::set_boundary_conditions`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundaryConditions {
     pub inflow_m3_per_s: f64,
-}
-
-/// Largest inlet velocity as a fraction of c0: weakly compressible SPH keeps the Mach number
-/// near 0.1, and at 0.3 c0 the jet's dynamic pressure alone compresses the water by about
-/// u^2 / (2 c0^2) = 4.5 %, half the 10 % bound of the weakly compressible range.
-pub const MAX_INLET_MACH: f64 = 0.3;
-
-/// The largest discharge the inlet of `f` carries with sound speed `c0`, m3/s:
-/// `MAX_INLET_MACH` c0 through the opening.
-pub fn max_inflow_m3_per_s(f: &OpenFlume, c0: f64) -> f64 {
-    MAX_INLET_MACH * c0 * f.inlet.height_m * f.width_m
-}
-
-/// Refuses a case whose own discharge (`open_flume.inflow_m3_per_s`) the inlet cannot carry:
-/// it would blow up in its first microseconds whatever the time step. Needs no GPU.
-pub fn check_inflow(case: &Case) -> Result<(), SolverError> {
-    let Some(f) = &case.open_flume else {
-        return Ok(());
-    };
-    let c0 = case::derive(case).c0;
-    let limit = max_inflow_m3_per_s(f, c0);
-    if f.inflow_m3_per_s > limit {
-        return Err(SolverError::InvalidParameter {
-            name: "open_flume.inflow_m3_per_s",
-            reason: format!(
-                "{} m3/s is more than the inlet carries: at most {limit:.4e} m3/s, an inlet velocity of {MAX_INLET_MACH} c0 = {:.3} m/s through the {} m x {} m opening",
-                f.inflow_m3_per_s,
-                MAX_INLET_MACH * c0,
-                f.inlet.height_m,
-                f.width_m
-            ),
-        });
-    }
-    Ok(())
 }
 
 /// The open flume's state on the host.
@@ -83,7 +48,7 @@ pub struct Injection {
 impl FlumeState {
     pub fn new(case: &Case, particles: &Particles) -> Option<FlumeState> {
         let config = case.open_flume.clone()?;
-        let parked = case::parked_phase(case);
+        let parked = parked_phase(case);
         let parked_particles = (0..particles.len())
             .filter(|&i| particles.phase(i) == parked)
             .count() as u64;
@@ -160,6 +125,7 @@ pub fn parked_slots(positions: &[[f32; 4]], ids: &[u32], parked_phase: u32) -> V
 mod tests {
     use super::*;
     use crate::config::{CollectorConfig, InletConfig};
+    use crate::derived::max_inflow_m3_per_s;
 
     /// 0.3 c0 through a 2 cm x 8.6 cm opening with c0 = 10 m/s: 3 m/s x 1.72e-3 m2.
     #[test]

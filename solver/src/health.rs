@@ -15,9 +15,9 @@
 //! whole, counted and logged. A closed tank (a verification case, short, with nowhere to
 //! recycle a particle) keeps the 10 % bound as a failure.
 
-use crate::case::{Particles, WALL_PHASE};
 use crate::config::Case;
 use crate::gpu::params::ExcludedParticle;
+use crate::particles::{Particles, WALL_PHASE, parked_phase};
 
 /// |rho / rho0 - 1| above which a density is a runaway in a closed tank, and the start-up bound:
 /// ten times the 1 % that a weakly compressible flow shows with c0 >= 10 u_max (Eq. 5).
@@ -150,7 +150,7 @@ pub fn worst_particles(
     particles: &Particles,
     count: usize,
 ) -> Vec<Culprit> {
-    let parked = crate::case::parked_phase(case);
+    let parked = parked_phase(case);
     let badness = |i: usize| -> f32 {
         let (p, v) = (particles.positions[i], particles.vel_rho[i]);
         if !p.iter().chain(&v).all(|x| x.is_finite()) {

@@ -4,25 +4,60 @@
 //!
 //! Start at `pipeline.rs`: its step lists every stage; each stage name leads to its WGSL file
 //! in `shaders/stages/`, its spec in `stages.rs` and its CPU oracle in `physics`.
+//!
+//! The API is what the crate root re-exports, plus `config` (the case file's types) and
+//! `physics` (the reference model). The other public modules are internals, reachable only so
+//! that the solver's own tests can drive single stages and compare them with their oracles.
 
-pub mod backend;
-pub mod case;
-pub mod config;
-pub mod cpu;
-pub mod engine;
-pub mod flume;
-pub mod gpu;
-pub mod health;
-pub mod observe;
-pub mod physics;
-pub mod pipeline;
-pub mod simulation;
-pub mod stages;
-pub mod uniform;
+// The API.
 
-pub use backend::Backend;
+pub use backend::{Backend, CPU_BACKEND};
 pub use config::{Case, ConfigError};
+pub use derived::{Derived, check_inflow, derive, max_inflow_m3_per_s};
+pub use engine::StageTime;
+pub use error::SolverError;
 pub use flume::BoundaryConditions;
+pub use generate::generate;
+pub use gpu::context::ADAPTER_ENV;
 pub use gpu::{GpuContext, GpuError};
-pub use observe::{Observations, ProfileColumn};
-pub use simulation::{Health, Recovery, Simulation, SolverError};
+pub use health::{Culprit, Health, Recovery};
+pub use observe::{
+    BedInterfaces, FlumeObservation, GaugeReading, Observations, ProbeReading, ProfileColumn,
+};
+pub use particles::{ParticleRegion, Particles};
+pub use physics::sediment::suspension::Region;
+pub use simulation::Simulation;
+
+/// The case file's types: `Case` and its sections.
+pub mod config;
+/// The reference model: every formula once, called by both backends and by the O(N^2) oracle
+/// that the tests compare them with.
+pub mod physics;
+
+mod backend;
+mod cpu;
+mod derived;
+mod engine;
+mod error;
+mod flume;
+mod health;
+mod load;
+mod observe;
+mod uniform;
+
+// Internals that the solver's tests (`solver/tests/`) reach into: stage specs, uniform
+// layouts, pipeline constants, the recovery policy, phase codes and parking spots, the
+// generator's count. Hidden from the docs; not for the node.
+
+#[doc(hidden)]
+pub mod generate;
+#[doc(hidden)]
+pub mod gpu;
+#[doc(hidden)]
+pub mod particles;
+#[doc(hidden)]
+pub mod pipeline;
+#[doc(hidden)]
+pub mod simulation;
+#[doc(hidden)]
+pub mod stages;

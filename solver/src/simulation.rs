@@ -4,66 +4,19 @@
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s).
 
 use crate::backend::Backend;
-use crate::case::{self, Derived, Particles, WALL_PHASE};
 use crate::config::{Case, Integrator, Viscosity, YieldCriterion};
+use crate::derived::{Derived, MAX_INLET_MACH, check_inflow, derive, max_inflow_m3_per_s};
 use crate::engine::{Engine, StageTime};
-use crate::flume::{
-    BoundaryConditions, FlumeState, MAX_INLET_MACH, max_inflow_m3_per_s, parked_slots,
-};
-use crate::gpu::GpuError;
+use crate::error::SolverError;
+use crate::flume::{BoundaryConditions, FlumeState, parked_slots};
+use crate::generate::{count, generate};
 use crate::gpu::engine::{GpuEngine, PipelineShape, by_id};
 use crate::gpu::params::*;
 use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
+use crate::particles::{Parking, ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
 use crate::uniform::{inlet_velocity, sim_params};
-
-#[derive(Debug, thiserror::Error)]
-pub enum SolverError {
-    #[error(transparent)]
-    Gpu(#[from] GpuError),
-    #[error("the case has {0} particles; the solver's indices are 32-bit")]
-    TooManyParticles(u64),
-    #[error(
-        "the case's neighbour grid has {0} cells; the solver's cell indices are 32-bit: use a coarser dp or a smaller domain"
-    )]
-    TooManyCells(u64),
-    #[error(
-        "simulation blew up at t = {time_s:.6} s (step {step}): {health}{}; worst particles: {}",
-        recurring_cfl.map_or(String::new(), |c| format!(
-            "; it recurred at about the same simulated time at every CFL down to {}: not a time-step problem",
-            c as f32
-        )),
-        health::list(culprits)
-    )]
-    BlowUp {
-        time_s: f64,
-        step: u64,
-        health: Health,
-        /// The particles furthest from health when it failed (excluded ones first), worst first.
-        culprits: Vec<Culprit>,
-        /// The CFL number of a retry that failed at the same simulated time as the try before.
-        recurring_cfl: Option<f64>,
-    },
-    #[error("cannot advance to t = {target_s} s: the simulation is already at {now_s} s")]
-    TimeGoesBack { target_s: f64, now_s: f64 },
-    #[error(
-        "c0 = {c0_m_per_s:.3} m/s is too low for fluid {fluid_height_m} m high: at rest its density \
-         is already {:.1} % off rest density (the bound is 10 %); use c0 above {c0_needed_m_per_s:.2} m/s \
-         (coefsound 10 or more is usual)",
-        100.0 * density_error
-    )]
-    SoundSpeedTooLow {
-        c0_m_per_s: f64,
-        fluid_height_m: f64,
-        density_error: f64,
-        c0_needed_m_per_s: f64,
-    },
-    #[error("the CPU backend cannot start its threads: {0}")]
-    CpuThreads(String),
-    #[error("parameter `{name}` refused: {reason}")]
-    InvalidParameter { name: &'static str, reason: String },
-}
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
@@ -120,9 +73,9 @@ fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverE
         let mut hi = case.domain.max_m[k] + margin;
         if k == d - 1 {
             // Room above the tank for splashes; particles above the grid still live in its top row.
-            hi += case::SPLASH_ROOM * (case.domain.max_m[k] - case.domain.min_m[k]);
+            hi += SPLASH_ROOM * (case.domain.max_m[k] - case.domain.min_m[k]);
             if case.open_flume.is_some() {
-                hi = hi.max(case::Parking::new(case, h).top(n) + margin);
+                hi = hi.max(Parking::new(case, h).top(n) + margin);
             }
         }
         dims[k] = ((hi - lo) / cell).ceil().clamp(1.0, f64::from(u32::MAX)) as u32;
@@ -141,8 +94,8 @@ fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverE
 impl Simulation {
     pub fn new(backend: impl Into<Backend>, case: &Case) -> Result<Simulation, SolverError> {
         let backend = backend.into();
-        let derived = case::derive(case);
-        let count = case::count(case);
+        let derived = derive(case);
+        let count = count(case);
         let (grid_dims, _) = grid_for(case, derived.h, count)?;
         let n_cells = u64::from(grid_dims[3]);
         // Particle indices are u32 on the GPU, with headroom for index arithmetic.
@@ -152,12 +105,12 @@ impl Simulation {
         if let Backend::Gpu(gpu) = &backend {
             crate::pipeline::GpuBuffers::check_limits(gpu, count, n_cells)?;
         }
-        crate::flume::check_inflow(case)?;
-        let particles = case::generate(case, &derived);
+        check_inflow(case)?;
+        let particles = generate(case, &derived);
         // A sound speed too low for the fluid's height starts outside the weakly compressible
         // range: say so now, not as a blow-up at the first step.
         let worst = (0..particles.len())
-            .filter(|&i| particles.phase(i) != WALL_PHASE)
+            .filter(|&i| !particles.is_wall(i))
             .map(|i| {
                 let rho0 = derived.phases[particles.phase(i) as usize].rho0;
                 (f64::from(particles.vel_rho[i][3]) / rho0 - 1.0).abs()
@@ -184,7 +137,7 @@ impl Simulation {
         case: &Case,
         particles: Particles,
     ) -> Result<Simulation, SolverError> {
-        let derived = case::derive(case);
+        let derived = derive(case);
         let (grid_dims, grid_origin) = grid_for(case, derived.h, particles.len() as u64)?;
         let n = particles.len() as u32;
         let probes = observe::ProbeLayout::new(case, derived.h);
@@ -230,7 +183,7 @@ impl Simulation {
         let flume = FlumeState::new(case, &particles);
         let max_excluded = health::max_excluded_per_chunk(
             (0..particles.len())
-                .filter(|&i| particles.phase(i) != WALL_PHASE)
+                .filter(|&i| !particles.is_wall(i))
                 .count(),
         );
         Ok(Simulation {
@@ -274,8 +227,13 @@ impl Simulation {
     /// Particles that are not walls (parked ones included: they are water out of the flow).
     pub fn fluid_count(&self) -> usize {
         (0..self.initial_particles.len())
-            .filter(|&i| self.initial_particles.phase(i) != WALL_PHASE)
+            .filter(|&i| !self.initial_particles.is_wall(i))
             .count()
+    }
+    /// The phase code of parked particles, for readers of particle frames; none in a closed
+    /// tank, which parks none.
+    pub fn parked_phase(&self) -> Option<u32> {
+        self.flume.as_ref().map(|_| parked_phase(&self.case))
     }
     pub fn time_s(&self) -> f64 {
         self.time_s
@@ -664,7 +622,7 @@ impl Simulation {
         if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
             let mut counts = [0u32; 6];
             for w in self.regions()? {
-                counts[((w & 255) as usize).min(5)] += 1;
+                counts[usize::from(ParticleRegion::from_word(w).number())] += 1;
             }
             obs.region_counts = Some(counts);
         }

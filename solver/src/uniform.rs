@@ -2,10 +2,11 @@
 //! the sediment model and the open flume. The CPU backend reads the same block, and the
 //! sediment model of `physics` that both are tested against comes from the same case here.
 
-use crate::case::{self, Derived};
 use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
+use crate::derived::{self, Derived};
 use crate::gpu::params::*;
 use crate::health::{RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
+use crate::particles::{Parking, parked_phase};
 use crate::physics::sediment::SedimentParams;
 use crate::physics::sediment::pass::SedimentModel;
 use bytemuck::Zeroable;
@@ -40,7 +41,7 @@ pub fn sim_params(
             mu: p.viscosity_pa_s as f32,
             mobile: if p.mobile { 1.0 } else { 0.0 },
         };
-        tait_b[k] = case::tait_b(derived.c0, p.rho0) as f32;
+        tait_b[k] = derived::tait_b(derived.c0, p.rho0) as f32;
         if p.mobile
             && p.viscosity_pa_s > 0.0
             && matches!(case.numerics.viscosity, Viscosity::Laminar)
@@ -106,7 +107,7 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
         return FlumeGpu::zeroed();
     };
     let dp = case.numerics.dp_m;
-    let parking = case::Parking::new(case, derived.h);
+    let parking = Parking::new(case, derived.h);
     let (lo, hi) = (&case.domain.min_m, &case.domain.max_m);
     // An empty box (y_max = y_min) when there is no bottom outlet.
     let duct = f.bottom_outlet.as_ref().map_or([0.0; 4], |o| {
@@ -115,7 +116,7 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
     FlumeGpu {
         enabled: 1,
         water_phase: 1 + case.sediment_phases().map_or(0, |(_, w)| w) as u32,
-        parked_phase: case::parked_phase(case),
+        parked_phase: parked_phase(case),
         parking_cols: parking.cols,
         inlet_x_face: (lo[0] + (f64::from(f.inlet.layers) + 0.5) * dp) as f32,
         // Half a dp of margin each way: the buffer's rows are lattice points inside the

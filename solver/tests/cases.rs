@@ -3,7 +3,7 @@
 
 mod common;
 
-use flume_solver::case::Particles;
+use flume_solver::Particles;
 use flume_solver::{Backend, Case, Simulation};
 
 const CPU: Backend = Backend::Cpu { threads: 2 };
@@ -370,10 +370,7 @@ fn assert_same_bits(backends: &[Backend]) {
     }
     assert_ne!(
         bits(&first),
-        bits(&flume_solver::case::generate(
-            &c,
-            &flume_solver::case::derive(&c)
-        )),
+        bits(&flume_solver::generate(&c, &flume_solver::derive(&c))),
         "nothing moved"
     );
 }
@@ -393,7 +390,7 @@ fn a_case_larger_than_the_adapter_allows_fails_before_allocating() {
     let err = match Simulation::new(gpu, &c) {
         Ok(_) => panic!(
             "a case of {} particles was accepted",
-            flume_solver::case::count(&c)
+            flume_solver::generate::count(&c)
         ),
         Err(e) => e.to_string(),
     };

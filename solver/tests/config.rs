@@ -1,8 +1,10 @@
 //! Case files: every shipped case parses, generation matches the documented counts, and a
 //! malformed file fails with an error naming the field and the reason. No GPU needed.
 
-use flume_solver::case::{self, WALL_PHASE};
+use flume_solver::generate::count;
+use flume_solver::particles::{Parking, WALL_PHASE, parked_phase};
 use flume_solver::{Case, ConfigError};
+use flume_solver::{derive, generate};
 use std::path::Path;
 
 fn launch_config(name: &str) -> Case {
@@ -45,12 +47,12 @@ fn every_shipped_case_parses() {
 #[test]
 fn dualsphysics_dambreak_copy_has_its_particle_counts() {
     let c = launch_config("dsph_dambreak_val2d.yaml");
-    let d = case::derive(&c);
-    let p = case::generate(&c, &d);
+    let d = derive(&c);
+    let p = generate(&c, &d);
     let walls = (0..p.len()).filter(|&i| p.phase(i) == WALL_PHASE).count();
     assert_eq!(p.len(), 21_001);
     assert_eq!(walls, 1_001);
-    assert_eq!(case::count(&c), 21_001);
+    assert_eq!(count(&c), 21_001);
     // h = sqrt(2) dp and c0 = 20 sqrt(g 2 m), as DualSPHysics computes them.
     assert!((d.h - 2f64.sqrt() * 0.01).abs() < 1e-12);
     assert!((d.c0 - 20.0 * (9.81f64 * 2.0).sqrt()).abs() < 1e-9);
@@ -63,8 +65,8 @@ fn count_matches_generate_for_every_case() {
     for name in ["dambreak_water.yaml", "dsph_dambreak_val2d.yaml"] {
         let c = launch_config(name);
         assert_eq!(
-            case::count(&c) as usize,
-            case::generate(&c, &case::derive(&c)).len(),
+            count(&c) as usize,
+            generate(&c, &derive(&c)).len(),
             "{name}"
         );
     }
@@ -74,8 +76,8 @@ fn count_matches_generate_for_every_case() {
             .join(name);
         let c = Case::from_path(&path).expect("parses");
         assert_eq!(
-            case::count(&c) as usize,
-            case::generate(&c, &case::derive(&c)).len(),
+            count(&c) as usize,
+            generate(&c, &derive(&c)).len(),
             "{name}"
         );
     }
@@ -84,8 +86,8 @@ fn count_matches_generate_for_every_case() {
 #[test]
 fn initial_density_is_hydrostatic() {
     let c = launch_config("dambreak_water.yaml");
-    let d = case::derive(&c);
-    let p = case::generate(&c, &d);
+    let d = derive(&c);
+    let p = generate(&c, &d);
     let b = d.c0 * d.c0 * 1000.0 / 7.0;
     for i in 0..p.len() {
         let depth = (0.2 - f64::from(p.positions[i][1])).max(0.0);
@@ -277,10 +279,10 @@ fn bottom_outlet_values_are_refused_with_field_and_reason() {
 #[test]
 fn an_open_flume_parks_its_reservoir_above_the_flow() {
     let c = launch_config("ulbra_flume.yaml");
-    let d = case::derive(&c);
-    let p = case::generate(&c, &d);
-    let parked = case::parked_phase(&c);
-    let parking = case::Parking::new(&c, d.h);
+    let d = derive(&c);
+    let p = generate(&c, &d);
+    let parked = parked_phase(&c);
+    let parking = Parking::new(&c, d.h);
     let f = c.open_flume.as_ref().expect("open flume");
     let mut n = 0;
     for i in 0..p.len() {
@@ -293,10 +295,7 @@ fn an_open_flume_parks_its_reservoir_above_the_flow() {
         assert!(f64::from(p.positions[i][1]) >= c.domain.max_m[1] + 2.0 * d.h);
     }
     assert_eq!(n, f.reservoir_particles as usize);
-    assert!(
-        case::count(&c) as usize >= p.len(),
-        "count is an upper bound"
-    );
+    assert!(count(&c) as usize >= p.len(), "count is an upper bound");
 }
 
 #[test]

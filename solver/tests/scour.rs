@@ -5,7 +5,7 @@
 
 mod common;
 
-use flume_solver::case::Particles;
+use flume_solver::Particles;
 use flume_solver::{BoundaryConditions, Case, Simulation};
 
 use common::ulbra_ci;
@@ -36,7 +36,7 @@ fn assert_nothing_leaks(
     sim: &Simulation,
     start: &Particles,
     now: &Particles,
-    f: &flume_solver::observe::FlumeObservation,
+    f: &flume_solver::FlumeObservation,
 ) {
     assert_eq!(now.len(), start.len(), "the particle count changed");
     let mass = |p: &Particles| -> f64 {
@@ -413,7 +413,7 @@ fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
     let c =
         Case::from_path(&common::case_path("tests/cases/collector_2d.yaml")).expect("case parses");
     let mut sim = Simulation::new(gpu, &c).expect("case builds");
-    let parked = flume_solver::case::parked_phase(&c);
+    let parked = flume_solver::particles::parked_phase(&c);
     let start = sim.read_particles().expect("reads");
     sim.advance_to(0.5).expect("runs");
     let obs = sim.observe().expect("observes");

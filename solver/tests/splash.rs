@@ -5,8 +5,9 @@
 
 mod common;
 
-use flume_solver::case::{self, parked_phase};
+use flume_solver::particles::parked_phase;
 use flume_solver::{Case, Health, Simulation, SolverError};
+use flume_solver::{derive, generate};
 
 const WATER: u32 = 1;
 
@@ -23,7 +24,7 @@ fn ulbra_ci_still() -> Case {
 /// at `at`, moving at `velocity`; and the drop's id.
 fn with_drop(case: &Case, at: [f32; 2], velocity: [f32; 2]) -> Option<(Simulation, u32)> {
     let gpu = common::gpu()?;
-    let mut p = case::generate(case, &case::derive(case));
+    let mut p = generate(case, &derive(case));
     let parked = parked_phase(case);
     let id = (0..p.len())
         .find(|&i| p.phase(i) == parked)

@@ -8,9 +8,10 @@
 mod common;
 
 use common::ulbra_ci;
-use flume_solver::case::{Parking, Particles, parked_phase};
-use flume_solver::observe::{FlumeObservation, Observations};
+use flume_solver::Particles;
+use flume_solver::particles::{Parking, parked_phase};
 use flume_solver::{Backend, Simulation};
+use flume_solver::{FlumeObservation, Observations};
 use std::time::Instant;
 
 const WATER: u32 = 1;

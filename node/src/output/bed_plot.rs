@@ -175,7 +175,7 @@ pub fn draw(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flume_solver::observe::BedInterfaces;
+    use flume_solver::BedInterfaces;
 
     fn column(x: f64, zs: Option<f64>) -> ProfileColumn {
         ProfileColumn {

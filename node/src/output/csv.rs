@@ -188,7 +188,7 @@ pub fn field(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flume_solver::observe::{GaugeReading, ProbeReading};
+    use flume_solver::{GaugeReading, ProbeReading};
 
     #[test]
     fn header_and_rows_with_missing_values() {
@@ -260,7 +260,7 @@ mod tests {
     fn bed_profile_rows_skip_columns_without_interfaces() {
         let mut buf = Vec::new();
         let mut csv = BedProfileCsv::new(&mut buf).unwrap();
-        let bed = flume_solver::observe::BedInterfaces {
+        let bed = flume_solver::BedInterfaces {
             zb_m: Some(0.05),
             zs_m: Some(0.0625),
             zw_m: None,

@@ -5,12 +5,12 @@
 //! Legacy binary VTK is big-endian whatever the machine, and the points are always 3-D
 //! (z = 0 in a 2-D case) because readers have no 2-D point type.
 
-use flume_solver::case::Particles;
+use flume_solver::{ParticleRegion, Particles};
 use std::io::{self, Write};
 
 /// Writes `particles` as one vertex cell per particle with velocity, density, phase, region,
-/// held flag and id. `regions` are the solver's region words in id order (region 1-5 of the
-/// scour model, 0 for walls, plus 256 when held fixed); missing entries count as 0.
+/// held flag and id. `regions` are the solver's region words in id order
+/// (`Simulation::regions`); missing entries count as 0 (no region, not held).
 /// `title` goes on the header's comment line (VTK allows at most 255 characters, no newline).
 /// When `marked` names ids (the particles a blow-up report names), a `culprit` field is 1 for
 /// them and 0 elsewhere.
@@ -64,20 +64,19 @@ pub fn write_particles<W: Write>(
     }
     writeln!(w)?;
     writeln!(w, "SCALARS phase int 1\nLOOKUP_TABLE default")?;
-    for p in &particles.positions {
-        // The solver keeps the phase index in w as raw bits; 0 is the wall.
-        put_i32s(&mut w, &[p[3].to_bits() as i32])?;
+    for i in 0..n {
+        put_i32s(&mut w, &[particles.phase(i) as i32])?;
     }
     writeln!(w)?;
-    let word = |i: usize| regions.get(i).copied().unwrap_or(0);
+    let region = |i: usize| ParticleRegion::from_word(regions.get(i).copied().unwrap_or(0));
     writeln!(w, "SCALARS region int 1\nLOOKUP_TABLE default")?;
     for i in 0..n {
-        put_i32s(&mut w, &[(word(i) & 255) as i32])?;
+        put_i32s(&mut w, &[i32::from(region(i).number())])?;
     }
     writeln!(w)?;
     writeln!(w, "SCALARS held int 1\nLOOKUP_TABLE default")?;
     for i in 0..n {
-        put_i32s(&mut w, &[((word(i) >> 8) & 1) as i32])?;
+        put_i32s(&mut w, &[i32::from(region(i).held)])?;
     }
     writeln!(w)?;
     writeln!(w, "SCALARS id int 1\nLOOKUP_TABLE default")?;

@@ -16,14 +16,14 @@ mod observe;
 mod step;
 mod store;
 
-use crate::case::Particles;
 use crate::engine::{Engine, RawState, StageTime};
+use crate::error::SolverError;
 use crate::gpu::engine::{PipelineShape, by_id};
 use crate::gpu::params::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
+use crate::particles::Particles;
 use crate::physics;
 use crate::physics::sediment::pass::SedimentModel;
 use crate::physics::sediment::suspension::Region;
-use crate::simulation::SolverError;
 use grid::Grid;
 
 /// The line naming the CPU backend on `threads` threads (0: one per core).

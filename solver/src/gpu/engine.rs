@@ -4,10 +4,10 @@
 use super::GpuContext;
 use super::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use super::params::{Extremes, SimParams, StepState};
-use crate::case::Particles;
 use crate::engine::{Engine, RawState, StageTime};
+use crate::error::SolverError;
+use crate::particles::Particles;
 use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
-use crate::simulation::SolverError;
 use std::sync::Arc;
 
 /// Which optional stages a case's pipeline has.

@@ -131,17 +131,13 @@ impl Jitter {
 
 /// The case's lattice with every fluid particle displaced by up to 0.2 dp, given a velocity of
 /// up to `speed` and a density off rho0 by up to 1 %: no symmetry left to hide a wrong sign.
-pub fn perturbed(
-    sim: &flume_solver::Simulation,
-    speed: f32,
-    seed: u64,
-) -> flume_solver::case::Particles {
+pub fn perturbed(sim: &flume_solver::Simulation, speed: f32, seed: u64) -> flume_solver::Particles {
     let mut p = sim.initial_particles().clone();
     let dp = sim.case().numerics.dp_m as f32;
     let d = sim.case().dim();
     let mut j = Jitter(seed);
     for i in 0..p.len() {
-        if p.phase(i) == flume_solver::case::WALL_PHASE {
+        if p.phase(i) == flume_solver::particles::WALL_PHASE {
             p.vel_rho[i][3] *= 1.0 + 0.005 * (j.next() + 1.0);
             continue;
         }
@@ -163,7 +159,7 @@ pub fn perturbed_sim(
     seed: u64,
 ) -> (
     flume_solver::Simulation,
-    flume_solver::case::Particles,
+    flume_solver::Particles,
     flume_solver::physics::Params,
 ) {
     let backend = backend.into();

@@ -158,7 +158,7 @@ pub fn check_symplectic_step(backend: &Backend) {
 /// force passes' tolerance (1e-4 of the largest rate, ~1e4 m/s2 in these perturbed states)
 /// moves a particle over the steps; velocities and densities within that tolerance times dt.
 pub fn assert_step_close(
-    after: &flume_solver::case::Particles,
+    after: &flume_solver::Particles,
     pos: &[[f32; 4]],
     vel_rho: &[[f32; 4]],
     passes: &[&Vec<[f32; 4]>],
@@ -344,7 +344,7 @@ pub fn sediment_in_motion(
     seed: u64,
 ) -> (
     flume_solver::Simulation,
-    flume_solver::case::Particles,
+    flume_solver::Particles,
     flume_solver::physics::Params,
 ) {
     let lattice = flume_solver::Simulation::new(backend.clone(), c).expect("builds");
@@ -368,7 +368,7 @@ fn check_rheology_round(
     sim: &mut flume_solver::Simulation,
     params: &flume_solver::physics::Params,
     model: &flume_solver::physics::sediment::pass::SedimentModel,
-    particles: &flume_solver::case::Particles,
+    particles: &flume_solver::Particles,
     held: &[bool],
 ) -> (Vec<bool>, usize, [usize; 6]) {
     use flume_solver::physics::sediment::{hold, pass};

@@ -1,105 +1,13 @@
-//! Turns a validated `Case` into particles on the dp lattice and the derived physical constants.
+//! Turns a validated `Case` into particles on the dp lattice.
 //!
 //! Like DualSPHysics' GenCase, every particle sits on the lattice of integer multiples of dp:
 //! wall particles on the tank's faces and `layers - 1` rows outside them, fluid at the lattice
 //! points inside each block (`min < x <= max`) that no wall or earlier block already holds.
 
-use crate::config::{Case, SoundSpeed};
+use crate::config::{Case, OpenFlume};
+use crate::derived::{Derived, tait_b};
+use crate::particles::{Parking, Particles, WALL_PHASE, parked_phase};
 use std::collections::HashSet;
-
-/// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
-pub const WALL_PHASE: u32 = 0;
-
-/// GPU phase index of parked particles in an open flume: the one after the case's phases.
-pub fn parked_phase(case: &Case) -> u32 {
-    case.phases.len() as u32 + 1
-}
-
-/// Where parked particles wait in an open flume: a lattice of spots dp apart above the flume,
-/// one per particle id, clear of the splash room above the walls by 4h, so that no parked
-/// particle comes within a kernel support of the flow.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Parking {
-    pub x0: f64,
-    pub y0: f64,
-    pub cols: u32,
-    pub dp: f64,
-}
-
-impl Parking {
-    pub fn new(case: &Case, h: f64) -> Parking {
-        let dp = case.numerics.dp_m;
-        let (lo, hi) = (&case.domain.min_m, &case.domain.max_m);
-        let height = hi[1] - lo[1];
-        Parking {
-            x0: lo[0] + 0.5 * dp,
-            y0: hi[1] + SPLASH_ROOM * height + 4.0 * h,
-            cols: ((hi[0] - lo[0]) / dp).floor().max(1.0) as u32,
-            dp,
-        }
-    }
-
-    /// The spot of particle `id`, m.
-    pub fn spot(&self, id: u32) -> [f32; 2] {
-        [
-            (self.x0 + f64::from(id % self.cols) * self.dp) as f32,
-            (self.y0 + f64::from(id / self.cols) * self.dp) as f32,
-        ]
-    }
-
-    /// Top of the spots of `n` particles, m.
-    pub fn top(&self, n: u64) -> f64 {
-        self.y0 + (n / u64::from(self.cols) + 1) as f64 * self.dp
-    }
-}
-
-/// Room kept above a tank for splashes, as a fraction of its height (the neighbour grid covers
-/// it; particles above the grid still live in its top row).
-pub const SPLASH_ROOM: f64 = 0.25;
-
-/// Particle state on the CPU, in the GPU's layout (see `gpu::params`).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Particles {
-    /// x, y, z (z = 0 in 2-D) and, in w, the phase index as f32 bits.
-    pub positions: Vec<[f32; 4]>,
-    /// Velocity x, y, z and, in w, the density in kg/m3.
-    pub vel_rho: Vec<[f32; 4]>,
-    /// Stable identity of each particle (its index at generation).
-    pub ids: Vec<u32>,
-}
-
-impl Particles {
-    pub fn len(&self) -> usize {
-        self.positions.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.positions.is_empty()
-    }
-    pub fn phase(&self, i: usize) -> u32 {
-        self.positions[i][3].to_bits()
-    }
-}
-
-/// One phase as the solver sees it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PhaseProps {
-    pub rho0: f64,
-    /// Mass per particle, kg (per metre of width in 2-D): rho0 dp^dim.
-    pub mass: f64,
-    pub viscosity_pa_s: f64,
-    pub mobile: bool,
-}
-
-/// The physical constants every stage needs, derived once from the case.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Derived {
-    pub h: f64,
-    pub c0: f64,
-    /// Height of the fluid used for c0 with `coefsound`, m.
-    pub fluid_height: f64,
-    /// Index 0 is the wall.
-    pub phases: Vec<PhaseProps>,
-}
 
 fn lattice_bounds(case: &Case) -> (Vec<i64>, Vec<i64>) {
     let dp = case.numerics.dp_m;
@@ -282,7 +190,7 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
 
 /// Lattice points of the inlet buffer at the start: `layers` columns next to the upstream
 /// wall, over the opening's height (block semantics: `y_min < y <= y_min + height`).
-fn inlet_points(case: &Case, f: &crate::config::OpenFlume) -> Vec<Vec<i64>> {
+fn inlet_points(case: &Case, f: &OpenFlume) -> Vec<Vec<i64>> {
     let (lo, _) = lattice_bounds(case);
     let dp = case.numerics.dp_m;
     let (ylo, yhi) = block_bounds(
@@ -372,62 +280,4 @@ pub fn count(case: &Case) -> u64 {
         n += inlet_points(case, f).len() as u64 + u64::from(f.reservoir_particles);
     }
     n
-}
-
-/// The Tait constant B = c0^2 rho0 / 7 (Eq. 4, gamma = 7), in f64 for case setup.
-pub fn tait_b(c0: f64, rho0: f64) -> f64 {
-    c0 * c0 * rho0 / 7.0
-}
-
-/// h, c0 and the phase table of a case.
-pub fn derive(case: &Case) -> Derived {
-    let d = case.dim();
-    let dp = case.numerics.dp_m;
-    let vmin = case.domain.min_m[d - 1];
-    let top = case
-        .fluid_blocks
-        .iter()
-        .map(|b| b.max_m[d - 1])
-        .fold(vmin, f64::max);
-    let fluid_height = top - vmin;
-    let c0 = match case.numerics.sound_speed {
-        SoundSpeed {
-            c0_m_per_s: Some(c),
-            ..
-        } => c,
-        // A validated case gives exactly one of the two; a case built in code without either
-        // gets MODEL.md's usual c0 = 10 u_max.
-        SoundSpeed { coefsound, .. } => crate::physics::eos::c0_from_coefsound(
-            coefsound.unwrap_or(10.0),
-            case.gravity_magnitude(),
-            fluid_height,
-        ),
-    };
-    let vol = dp.powi(d as i32);
-    let mut phases = vec![PhaseProps {
-        rho0: case.phases[0].rho0_kg_per_m3,
-        mass: case.phases[0].rho0_kg_per_m3 * vol,
-        viscosity_pa_s: case.phases[0].viscosity_pa_s,
-        mobile: false,
-    }];
-    phases.extend(case.phases.iter().map(|p| PhaseProps {
-        rho0: p.rho0_kg_per_m3,
-        mass: p.rho0_kg_per_m3 * vol,
-        viscosity_pa_s: p.viscosity_pa_s,
-        mobile: true,
-    }));
-    if case.open_flume.is_some() {
-        // Parked particles are water waiting out of the flow.
-        let water = 1 + case.sediment_phases().map_or(0, |(_, w)| w);
-        phases.push(PhaseProps {
-            mobile: false,
-            ..phases[water]
-        });
-    }
-    Derived {
-        h: case.smoothing_length_m(),
-        c0,
-        fluid_height,
-        phases,
-    }
 }

@@ -1,0 +1,138 @@
+//! Particle state on the host and what its codes mean: the phase code each particle carries in
+//! `positions[i].w`, where parked particles wait, and the region word of the rheology pass.
+//! Callers ask a particle's kind here rather than decoding the bits themselves.
+
+use crate::config::Case;
+use crate::physics::sediment::pass::REGION_HELD;
+use crate::physics::sediment::suspension::Region;
+
+/// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
+pub const WALL_PHASE: u32 = 0;
+
+/// GPU phase index of parked particles in an open flume: the one after the case's phases.
+pub fn parked_phase(case: &Case) -> u32 {
+    case.phases.len() as u32 + 1
+}
+
+/// Where parked particles wait in an open flume: a lattice of spots dp apart above the flume,
+/// one per particle id, clear of the splash room above the walls by 4h, so that no parked
+/// particle comes within a kernel support of the flow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Parking {
+    pub x0: f64,
+    pub y0: f64,
+    pub cols: u32,
+    pub dp: f64,
+}
+
+impl Parking {
+    pub fn new(case: &Case, h: f64) -> Parking {
+        let dp = case.numerics.dp_m;
+        let (lo, hi) = (&case.domain.min_m, &case.domain.max_m);
+        let height = hi[1] - lo[1];
+        Parking {
+            x0: lo[0] + 0.5 * dp,
+            y0: hi[1] + SPLASH_ROOM * height + 4.0 * h,
+            cols: ((hi[0] - lo[0]) / dp).floor().max(1.0) as u32,
+            dp,
+        }
+    }
+
+    /// The spot of particle `id`, m.
+    pub fn spot(&self, id: u32) -> [f32; 2] {
+        [
+            (self.x0 + f64::from(id % self.cols) * self.dp) as f32,
+            (self.y0 + f64::from(id / self.cols) * self.dp) as f32,
+        ]
+    }
+
+    /// Top of the spots of `n` particles, m.
+    pub fn top(&self, n: u64) -> f64 {
+        self.y0 + (n / u64::from(self.cols) + 1) as f64 * self.dp
+    }
+}
+
+/// Room kept above a tank for splashes, as a fraction of its height (the neighbour grid covers
+/// it; particles above the grid still live in its top row).
+pub const SPLASH_ROOM: f64 = 0.25;
+
+/// Particle state on the CPU, in the GPU's layout (see `gpu::params`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Particles {
+    /// x, y, z (z = 0 in 2-D) and, in w, the phase code as f32 bits: read it with `phase`.
+    pub positions: Vec<[f32; 4]>,
+    /// Velocity x, y, z and, in w, the density in kg/m3.
+    pub vel_rho: Vec<[f32; 4]>,
+    /// Stable identity of each particle (its index at generation).
+    pub ids: Vec<u32>,
+}
+
+impl Particles {
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.positions.is_empty()
+    }
+    /// The phase code of particle `i`: `WALL_PHASE` for a wall, k + 1 for the case's phase k,
+    /// `parked_phase` for a particle parked out of an open flume's flow.
+    pub fn phase(&self, i: usize) -> u32 {
+        self.positions[i][3].to_bits()
+    }
+    pub fn is_wall(&self, i: usize) -> bool {
+        self.phase(i) == WALL_PHASE
+    }
+}
+
+/// A particle's region word (`Simulation::regions`), decoded. The backends keep the region in
+/// the word's low byte and `REGION_HELD` above it, as `shaders/common/sediment.wgsl` does.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ParticleRegion {
+    /// The region of Figure 2; none for walls, for every particle of a case without the
+    /// multiphase viscosity, and for sediment before the first step has classified it.
+    pub region: Option<Region>,
+    /// Sediment held fixed in the last rheology pass.
+    pub held: bool,
+}
+
+impl ParticleRegion {
+    pub fn from_word(word: u32) -> ParticleRegion {
+        let region = match word & REGION_MASK {
+            1 => Some(Region::Unyielded),
+            2 => Some(Region::Yielded),
+            3 => Some(Region::BedLoad),
+            4 => Some(Region::Suspended),
+            5 => Some(Region::Water),
+            _ => None,
+        };
+        ParticleRegion {
+            region,
+            held: word & REGION_HELD != 0,
+        }
+    }
+
+    /// The paper's number of the region, 1-5, and 0 for none: what particle frames, snapshots
+    /// and the region counts of `Observations` carry.
+    pub fn number(&self) -> u8 {
+        self.region.map_or(0, |r| r as u8)
+    }
+}
+
+/// The bits of a region word that hold the region (mirrors `& 255u` in the shaders).
+const REGION_MASK: u32 = 0xff;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_region_word_is_the_region_and_the_held_bit() {
+        let held_unyielded = ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD);
+        assert_eq!(held_unyielded.region, Some(Region::Unyielded));
+        assert!(held_unyielded.held);
+        assert_eq!(held_unyielded.number(), 1);
+        let water = ParticleRegion::from_word(Region::Water as u32);
+        assert_eq!((water.number(), water.held), (5, false));
+        assert_eq!(ParticleRegion::from_word(0), ParticleRegion::default());
+    }
+}
