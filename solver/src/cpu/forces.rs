@@ -3,7 +3,7 @@
 //! cell list, particles shared out among threads in blocks. Each sum is taken by one thread in
 //! sorted order, so the result does not depend on the number of threads.
 
-use super::neighbours::Neighbourhood;
+use super::grid::Grid;
 use crate::physics::interaction::{PairModel, PairSum, Side};
 use crate::physics::sediment::pass::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
@@ -24,12 +24,12 @@ pub struct Extra<'a> {
 }
 
 /// Fills `forces` (`[ax, ay, az, d rho/dt]`) and `dt_limit` (the stable step before the CFL
-/// factor) of each particle of `sides`, in sorted order, over the neighbours `near` gives
-/// (cells sorted from the same particles or from the state half a step before).
+/// factor) of each particle of `sides`, in sorted order; cells come from `grid`, whose
+/// starts were sorted from the same particles or from the state half a step before.
 pub fn force_pass(
     pool: &rayon::ThreadPool,
     model: &PairModel,
-    near: &impl Neighbourhood,
+    grid: &Grid,
     sides: &[Side],
     extra: &Extra,
     forces: &mut [[f32; 4]],
@@ -48,16 +48,20 @@ pub fn force_pass(
                     let side = &sides[i];
                     let mut sum = PairSum::default();
                     let mut tau = [0.0f32; 3];
-                    match extra.stress {
-                        None => near.visit(i, &side.x, |j| {
-                            model.add_pair(side, &sides[j], &mut sum);
-                        }),
-                        Some((div, stress, _)) => near.visit(i, &side.x, |j| {
-                            if let Some(g) = model.add_pair(side, &sides[j], &mut sum) {
-                                div.add_term(&stress[i], &stress[j], &g, &mut tau);
+                    grid.rows(grid.coords(&side.x), |range| match extra.stress {
+                        None => {
+                            for j in range {
+                                model.add_pair(side, &sides[j], &mut sum);
                             }
-                        }),
-                    }
+                        }
+                        Some((div, stress, _)) => {
+                            for j in range {
+                                if let Some(g) = model.add_pair(side, &sides[j], &mut sum) {
+                                    div.add_term(&stress[i], &stress[j], &g, &mut tau);
+                                }
+                            }
+                        }
+                    });
                     for (a, t) in sum.acc.iter_mut().zip(tau) {
                         *a += t;
                     }

@@ -11,7 +11,6 @@
 mod forces;
 mod grid;
 mod multiphase;
-mod neighbours;
 mod observe;
 mod step;
 mod store;
@@ -60,14 +59,12 @@ impl State {
     }
 }
 
-/// The stages timed apart, in step order; "neighbours" is the list of pairs the
-/// water-sediment model's passes share, "rheology" includes the release of held sand.
-const STAGES: [&str; 5] = ["sort", "neighbours", "rheology", "forces", "integrate"];
+/// The stages timed apart, in step order; "rheology" includes the release of held sand.
+const STAGES: [&str; 4] = ["sort", "rheology", "forces", "integrate"];
 const STAGE_SORT: usize = 0;
-const STAGE_NEIGHBOURS: usize = 1;
-const STAGE_RHEOLOGY: usize = 2;
-const STAGE_FORCES: usize = 3;
-const STAGE_INTEGRATE: usize = 4;
+const STAGE_RHEOLOGY: usize = 1;
+const STAGE_FORCES: usize = 2;
+const STAGE_INTEGRATE: usize = 3;
 
 pub struct CpuEngine {
     pool: rayon::ThreadPool,

@@ -3,7 +3,7 @@
 //! cell list, particles shared out among threads. A release reads the regions the rheology
 //! pass left, before any release, so it does not depend on the order threads run.
 
-use super::neighbours::Neighbourhood;
+use super::grid::Grid;
 use crate::physics::Params;
 use crate::physics::interaction::phase_index;
 use crate::physics::sediment::hold::{Release, Transmitted};
@@ -18,7 +18,7 @@ pub fn rheology_pass(
     pool: &rayon::ThreadPool,
     params: &Params,
     model: &SedimentModel,
-    near: &impl Neighbourhood,
+    grid: &Grid,
     pos: &[[f32; 4]],
     vel: &[[f32; 4]],
     held_before: &[bool],
@@ -40,8 +40,10 @@ pub fn rheology_pass(
                 let mut s = pass.start(me.0, me.1);
                 // A wall's rheology is none whatever its neighbours.
                 if params.phases[phase_index(me.0)].mobile {
-                    near.visit(i, &[pos[i][0], pos[i][1], pos[i][2]], |j| {
-                        pass.add_pair_of_volume(me, (&pos[j], &vel[j]), vol[j], &mut s);
+                    grid.rows(grid.coords(&[pos[i][0], pos[i][1], pos[i][2]]), |range| {
+                        for j in range {
+                            pass.add_pair_of_volume(me, (&pos[j], &vel[j]), vol[j], &mut s);
+                        }
                     });
                 }
                 pass.finish(me.0, me.1, &s, held_before[i])
@@ -58,8 +60,10 @@ pub fn rheology_pass(
                         return false;
                     }
                     let mut sums = Transmitted::default();
-                    near.visit(i, &[pos[i][0], pos[i][1], pos[i][2]], |j| {
-                        stage.add_pair(&pos[i], (&pos[j], &vel[j], &out[j]), &mut sums);
+                    grid.rows(grid.coords(&[pos[i][0], pos[i][1], pos[i][2]]), |range| {
+                        for j in range {
+                            stage.add_pair(&pos[i], (&pos[j], &vel[j], &out[j]), &mut sums);
+                        }
                     });
                     stage.released(vel[i][3], &sums)
                 })

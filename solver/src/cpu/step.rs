@@ -7,16 +7,13 @@
 use super::forces::{Extra, force_pass, min_dt};
 use super::grid::Grid;
 use super::multiphase::rheology_pass;
-use super::neighbours::{NeighbourList, Neighbourhood};
 use super::store::{Event, Store, tally};
-use super::{
-    CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_NEIGHBOURS, STAGE_RHEOLOGY, STAGE_SORT, State,
-};
+use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
 use crate::gpu::params::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
-use crate::physics::sediment::pass::{ParticleRheology, REGION_HELD, StressDivergence, StressSide};
+use crate::physics::sediment::pass::{REGION_HELD, StressDivergence, StressSide};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -42,9 +39,7 @@ impl CpuEngine {
     }
 
     /// (Rheology and release, then) forces and stable steps of the active particles of `b`
-    /// at positions `pos`, velocities `vel` (sorted order), cells from `grid`. The
-    /// water-sediment model's three neighbour passes share one list of the pairs within the
-    /// support; the water model's single pass walks the cells.
+    /// at positions `pos`, velocities `vel` (sorted order), cells from `grid`.
     pub(super) fn force_pass(
         &mut self,
         grid: &Grid,
@@ -53,82 +48,52 @@ impl CpuEngine {
         vel: &[[f32; 4]],
     ) -> (Vec<[f32; 4]>, Vec<f32>) {
         let active = grid.active() as usize;
-        if self.sediment.is_none() {
-            return self.forces_over(grid, None, pos, vel, active);
+        let start = Instant::now();
+        let rheology = self.sediment.as_ref().map(|model| {
+            let holds = self.holds(b);
+            let release = self.shape.yield_release;
+            let (params, pool) = (&self.model, &self.pool);
+            rheology_pass(
+                pool,
+                params,
+                model,
+                grid,
+                pos,
+                vel,
+                &holds[..active],
+                release,
+            )
+        });
+        if let Some(out) = &rheology {
+            for (r, &id) in out.iter().zip(&b.ids) {
+                self.regions[id as usize] = r.word();
+            }
+            // Parked particles are out of the flow: no region.
+            for &id in &b.ids[active..] {
+                self.regions[id as usize] = 0;
+            }
         }
-        let start = Instant::now();
-        let h = self.model.h;
-        let list = NeighbourList::new(&self.pool, grid, pos, active, 4.0 * h * h);
-        self.timed(STAGE_NEIGHBOURS, start);
-        let start = Instant::now();
-        let rheology = self.rheology(&list, b, pos, vel, active);
         self.timed(STAGE_RHEOLOGY, start);
-        self.forces_over(&list, rheology, pos, vel, active)
-    }
-
-    /// The rheology and release passes over `near`; the region words they leave are kept.
-    fn rheology(
-        &mut self,
-        near: &NeighbourList,
-        b: &State,
-        pos: &[[f32; 4]],
-        vel: &[[f32; 4]],
-        active: usize,
-    ) -> Option<Vec<ParticleRheology>> {
-        let model = self.sediment.as_ref()?;
-        let holds = self.holds(b);
-        let out = rheology_pass(
-            &self.pool,
-            &self.model,
-            model,
-            near,
-            pos,
-            vel,
-            &holds[..active],
-            self.shape.yield_release,
-        );
-        for (r, &id) in out.iter().zip(&b.ids) {
-            self.regions[id as usize] = r.word();
-        }
-        // Parked particles are out of the flow: no region.
-        for &id in &b.ids[active..] {
-            self.regions[id as usize] = 0;
-        }
-        Some(out)
-    }
-
-    /// The force pass over `near`, with the stresses of `rheology` where the model has them.
-    fn forces_over(
-        &mut self,
-        near: &impl Neighbourhood,
-        rheology: Option<Vec<ParticleRheology>>,
-        pos: &[[f32; 4]],
-        vel: &[[f32; 4]],
-        active: usize,
-    ) -> (Vec<[f32; 4]>, Vec<f32>) {
         let start = Instant::now();
         let model = PairModel::new(&self.model);
         let store = Store::new(&self.params, &self.model);
-        let div = StressDivergence::new(&self.model);
-        type Prepared = (Side, bool, Option<(StressSide, f32)>);
-        let prepared: Vec<Prepared> = self.pool.install(|| {
+        let (sides, imposed): (Vec<Side>, Vec<bool>) = self.pool.install(|| {
             (0..active)
                 .into_par_iter()
                 .map(|i| {
-                    let stress = rheology.as_ref().map(|r| {
-                        let r = &r[i];
-                        (div.side(&pos[i], vel[i][3], &r.stress), r.mu)
-                    });
-                    let side = model.side(&pos[i], &vel[i]);
-                    (side, store.velocity_imposed(&pos[i]), stress)
+                    (
+                        model.side(&pos[i], &vel[i]),
+                        store.velocity_imposed(&pos[i]),
+                    )
                 })
-                .collect()
+                .unzip()
         });
-        let sides: Vec<Side> = prepared.iter().map(|p| p.0).collect();
-        let imposed: Vec<bool> = prepared.iter().map(|p| p.1).collect();
-        let stress: Option<(Vec<StressSide>, Vec<f32>)> = rheology
-            .is_some()
-            .then(|| prepared.iter().filter_map(|p| p.2).unzip());
+        let div = StressDivergence::new(&self.model);
+        let stress: Option<(Vec<StressSide>, Vec<f32>)> = rheology.map(|r| {
+            (0..active)
+                .map(|i| (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu))
+                .unzip()
+        });
         let extra = Extra {
             stress: stress
                 .as_ref()
@@ -139,7 +104,7 @@ impl CpuEngine {
         force_pass(
             &self.pool,
             &model,
-            near,
+            grid,
             &sides,
             &extra,
             &mut forces,
