@@ -150,7 +150,7 @@ impl Simulation {
             return Err(SolverError::TooManyParticles(count));
         }
         if let Backend::Gpu(gpu) = &backend {
-            crate::pipeline::GpuBuffers::check_limits(gpu, count, n_cells)?;
+            crate::gpu::state::GpuBuffers::check_limits(gpu, count, n_cells)?;
         }
         crate::flume::check_inflow(case)?;
         let particles = case::generate(case, &derived);

@@ -4,9 +4,10 @@
 use super::GpuContext;
 use super::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use super::params::{Extremes, SimParams, StepState};
+use super::state::{GpuBuffers, StateBuffers};
 use crate::case::Particles;
 use crate::engine::{Engine, RawState, StageTime};
-use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
+use crate::pipeline::{Bindings, SphPipeline};
 use crate::simulation::SolverError;
 use std::sync::Arc;
 
@@ -190,6 +191,10 @@ impl Engine for GpuEngine {
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
         self.write_state(&StepState::chunk(f32::MAX, 0.0, 0.0, 0));
+        // The pass writes the active particles only: parked ones feel nothing.
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&self.buffers.forces, 0, None);
+        self.gpu.queue.submit([encoder.finish()]);
         self.submit(|pass| self.pipeline.record_forces(pass, &self.bindings));
         let b = &self.buffers;
         let raw = read_buffers(

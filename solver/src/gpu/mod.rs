@@ -6,5 +6,6 @@ pub mod engine;
 pub mod params;
 pub mod shader;
 pub mod stage;
+pub mod state;
 
 pub use context::{AdapterSummary, GpuContext, GpuError};
