@@ -339,6 +339,26 @@ pub const OBSERVE_REDUCE: StageSpec = StageSpec {
     workgroup: 128,
 };
 
+/// The open flume's inlet: occupied spots and parked slots (`Engine::inlet_scan`).
+pub const INLET_SCAN: StageSpec = StageSpec {
+    name: "inlet_scan",
+    shader: "stages/inlet_scan.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("query", 1, Uniform),
+        ("positions", 2, Read),
+        ("ids", 3, Read),
+        ("spots", 4, Read),
+        ("occupied", 5, ReadWrite),
+        ("parked_bits", 6, ReadWrite),
+        ("slot_of", 7, ReadWrite),
+        ("picks", 8, ReadWrite),
+    ],
+    entry_points: &["inlet_mark", "inlet_pick"],
+    workgroup: 128,
+};
+
 /// Every stage, for validation.
 pub const ALL: &[&StageSpec] = &[
     &GRID_CLEAR,
@@ -358,4 +378,5 @@ pub const ALL: &[&StageSpec] = &[
     &VERLET_UPDATE,
     &PROBE_INTERPOLATE,
     &OBSERVE_REDUCE,
+    &INLET_SCAN,
 ];

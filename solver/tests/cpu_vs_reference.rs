@@ -73,3 +73,8 @@ fn rheology_matches_the_oracle_shields_only() {
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     parked::check_parked_take_no_part(&CPU);
 }
+
+#[test]
+fn inlet_scan_matches_a_scan_of_the_whole_state() {
+    parked::check_inlet_scan(&CPU);
+}

@@ -77,3 +77,8 @@ fn rheology_matches_the_cpu_shields_only() {
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     on_gpu(parked::check_parked_take_no_part);
 }
+
+#[test]
+fn inlet_scan_matches_a_scan_of_the_whole_state() {
+    on_gpu(parked::check_inlet_scan);
+}

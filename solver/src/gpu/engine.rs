@@ -3,10 +3,11 @@
 
 use super::GpuContext;
 use super::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
+use super::inlet::InletScanner;
 use super::params::{Extremes, SimParams, StepState};
 use super::state::{GpuBuffers, StateBuffers};
 use crate::case::Particles;
-use crate::engine::{Engine, RawState, StageTime};
+use crate::engine::{Engine, InletScan, RawState, StageTime};
 use crate::pipeline::{Bindings, SphPipeline};
 use crate::simulation::SolverError;
 use std::sync::Arc;
@@ -26,6 +27,8 @@ pub struct GpuEngine {
     pipeline: SphPipeline,
     buffers: GpuBuffers,
     bindings: Bindings,
+    /// The open flume's inlet stage, built on the first call.
+    inlet: Option<InletScanner>,
     n: u64,
     n_probes: u64,
     n_cells: u64,
@@ -70,6 +73,7 @@ impl GpuEngine {
             pipeline,
             buffers,
             bindings,
+            inlet: None,
             n: u64::from(n),
             n_probes: u64::from(params.n_probes),
             n_cells: u64::from(params.n_cells),
@@ -181,6 +185,12 @@ impl Engine for GpuEngine {
         q.write_buffer(&a.positions, offset, bytemuck::bytes_of(&position));
         q.write_buffer(&a.vel_rho, offset, bytemuck::bytes_of(&vel_rho));
         q.write_buffer(&a.vel_rho_prev, offset, bytemuck::bytes_of(&vel_rho));
+    }
+
+    fn inlet_scan(&mut self, spots: &[[f32; 2]], radius: f32) -> Result<InletScan, SolverError> {
+        let gpu = &self.gpu;
+        let scanner = self.inlet.get_or_insert_with(|| InletScanner::new(gpu));
+        scanner.scan(gpu, &self.buffers, self.n as u32, spots, radius)
     }
 
     fn regions(&self) -> Result<Vec<u32>, SolverError> {

@@ -40,6 +40,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "stages/verlet_update.wgsl",
     "stages/probe_interpolate.wgsl",
     "stages/observe_reduce.wgsl",
+    "stages/inlet_scan.wgsl",
 ];
 
 pub fn source(path: &str) -> &'static str {

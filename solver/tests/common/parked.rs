@@ -1,6 +1,7 @@
 //! An open flume's parked particles and its inlet, for any backend (`gpu_vs_reference.rs`,
 //! `cpu_vs_reference.rs`): parked particles sort after every cell and take no part in the
-//! neighbour passes or the integrators.
+//! neighbour passes or the integrators, and the inlet's scan answers what a scan of the whole
+//! state would.
 
 use flume_solver::case::{Particles, WALL_PHASE, parked_phase};
 use flume_solver::config::Integrator;
@@ -98,4 +99,73 @@ pub fn check_parked_take_no_part(backend: &Backend) {
             }
         }
     }
+}
+
+/// The inlet's scan against `engine::inlet_scan` over the whole state, on a state whose
+/// lowest-id parked particles are back in the flow and some low-id water is parked; before and
+/// after a step (which reorders the storage), and with more spots than parked particles.
+pub fn check_inlet_scan(backend: &Backend) {
+    let c = flume(Integrator::default());
+    let parked = parked_phase(&c);
+    let dp = c.numerics.dp_m as f32;
+    let lattice = Simulation::new(backend.clone(), &c).expect("case builds");
+    let mut p = lattice.initial_particles().clone();
+    let water = (0..p.len())
+        .filter(|&i| p.phase(i) == 1)
+        .collect::<Vec<_>>();
+    let lowest_parked = (0..p.len())
+        .filter(|&i| p.phase(i) == parked)
+        .take(2)
+        .collect::<Vec<_>>();
+    for (k, &i) in lowest_parked.iter().enumerate() {
+        p.positions[i] = [0.3 + k as f32 * dp, 0.09, 0.0, f32::from_bits(1)];
+    }
+    for &i in &water[3..6] {
+        p.positions[i][3] = f32::from_bits(parked);
+    }
+    let w = p.positions[water[40]];
+    let spots = [
+        [w[0], w[1]],
+        [w[0] + 0.4 * dp, w[1]],
+        [w[0] + 0.35 * dp, w[1] + 0.45 * dp],
+        [p.positions[water[4]][0], p.positions[water[4]][1]],
+        [0.3, 0.09],
+        [0.2, 0.11],
+    ];
+    let want_occupied = [true, true, false, false, true, false];
+    let mut sim = sim(backend, &c, &p);
+    let radius = 0.5 * dp;
+    let scan = |sim: &mut Simulation, spots: &[[f32; 2]]| {
+        let got = sim.inlet_scan(spots, radius).expect("inlet scan");
+        let now = sim.read_particles().expect("readback");
+        let want =
+            flume_solver::engine::inlet_scan(&now.positions, &now.ids, parked, spots, radius);
+        let want_ids: Vec<u32> = want.parked_slots.iter().map(|&k| k as u32).collect();
+        assert_eq!(got, (want.occupied, want_ids));
+        got
+    };
+    let (occupied, ids) = scan(&mut sim, &spots);
+    assert_eq!(occupied, want_occupied);
+    let want_ids: Vec<u32> = (0..p.len() as u32)
+        .filter(|&i| p.phase(i as usize) == parked)
+        .take(spots.len())
+        .collect();
+    assert_eq!(ids, want_ids, "lowest id first");
+    assert_eq!(
+        ids[..3],
+        [3, 4, 5].map(|k| water[k] as u32),
+        "the parked water first"
+    );
+
+    sim.advance_to(2.0e-5).expect("one step");
+    scan(&mut sim, &spots);
+    // More spots than parked particles, in the air above the water: every parked one, in order.
+    let air: Vec<[f32; 2]> = (0..100).map(|k| [0.06 + 0.003 * k as f32, 0.105]).collect();
+    let (occupied, ids) = scan(&mut sim, &air);
+    assert!(occupied.iter().all(|o| !o));
+    let n_parked = sim.read_particles().expect("readback");
+    let n_parked = (0..n_parked.len())
+        .filter(|&i| n_parked.phase(i) == parked)
+        .count();
+    assert_eq!(ids.len(), n_parked);
 }
