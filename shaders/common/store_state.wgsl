@@ -64,8 +64,8 @@ fn out_of_range(rho: f32, rho0: f32) -> bool {
 // rho0 so that they never pull fluid in. Held sediment (`is_held`) keeps its position, at rest,
 // and without tension (clamp_pressure) its density stays at or above rest as a free particle's
 // does: a held bed under sand sliding off it would otherwise thin out without end.
-// In an open flume: parked particles stay parked; fluid past the outlet and sediment in the
-// collector are parked; the inlet buffer moves at the inlet velocity, at its density; water in
+// In an open flume (whose parked particles never get here: the integrators run over the active
+// ones only): fluid past the outlet and sediment in the collector are parked; the inlet buffer moves at the inlet velocity, at its density; water in
 // a bottom outlet's duct moves at the valve's velocity; a free particle whose density leaves
 // the range is excluded (a lone splash meeting a wall compresses by about its Mach number
 // v / c0: that is one particle's fate, not a blow-up of the run).
@@ -118,9 +118,6 @@ fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: ve
         positions_out[i] = vec4<f32>(x, p.w);
         vel_rho_out[i] = vec4<f32>(v, r);
         check_health(x, v, r, ph.rho0);
-    } else if (f.enabled != 0u && phase == f.parked_phase) {
-        positions_out[i] = p;
-        vel_rho_out[i] = vr;
     } else {
         positions_out[i] = p;
         vel_rho_out[i] = vec4<f32>(vr.xyz, max(rho, ph.rho0));

@@ -36,19 +36,14 @@ override REDUCE_DT: bool = true;
 @compute @workgroup_size(64)
 fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_particles || chunk_idle(REDUCE_DT)) {
+    // Dispatched over the active particles (cell_starts[n_cells]: parked ones sort after every
+    // cell and are in no stencil), rounded up to whole workgroups.
+    if (i >= cell_starts[params.n_cells] || chunk_idle(REDUCE_DT)) {
         return;
     }
     let pos_i = textureLoad(positions, texel(i), 0);
     let vr_i = textureLoad(vel_rho, texel(i), 0);
     let phase_i = bitcast<u32>(pos_i.w);
-    // Parked particles (open flume) take no part; nothing moves them.
-    let parked = params.flume.parked_phase;
-    let flume = params.flume.enabled != 0u;
-    if (flume && phase_i == parked) {
-        forces[i] = vec4<f32>(0.0);
-        return;
-    }
     let mobile_i = params.phases[phase_i].mobile > 0.5;
     let rho_i = vr_i.w;
     let press_i = momentum_pressure(rho_i, phase_i) / (rho_i * rho_i);
@@ -81,7 +76,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let phase_j = bitcast<u32>(pos_j.w);
             let mobile_j = params.phases[phase_j].mobile > 0.5;
-            if ((!mobile_i && !mobile_j) || (flume && phase_j == parked)) {
+            if (!mobile_i && !mobile_j) {
                 continue;
             }
             let vr_j = textureLoad(vel_rho, texel(j), 0);
@@ -141,7 +136,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (mobile_i) {
         acc += params.gravity.xyz;
         let a = length(acc);
-        if (a > 0.0 && !(flume && velocity_imposed(pos_i.xyz, phase_i))) {
+        if (a > 0.0 && !velocity_imposed(pos_i.xyz, phase_i)) {
             dt_i = sqrt(h / a);
         }
         dt_i = min(dt_i, h / (params.c0 + visc_max));

@@ -23,7 +23,8 @@ override BEFORE_DT: bool = true;
 @compute @workgroup_size(64)
 fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_particles || chunk_idle(BEFORE_DT)) {
+    // Over the active particles only, as the force pass.
+    if (i >= cell_starts[params.n_cells] || chunk_idle(BEFORE_DT)) {
         return;
     }
     let pos_i = textureLoad(positions, texel(i), 0);
@@ -68,9 +69,6 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let phase_j = bitcast<u32>(pos_j.w);
-            if (params.flume.enabled != 0u && phase_j == params.flume.parked_phase) {
-                continue;
-            }
             let vr_j = textureLoad(vel_rho, texel(j), 0);
             let m_j = params.phases[phase_j].mass;
             let v_j = m_j / vr_j.w;

@@ -1,7 +1,8 @@
 // Symplectic position-Verlet integration as in DualSPHysics, second half step:
 // v(n+1) = v(n) + dt a(n+1/2), x(n+1) = x(n) + dt (v(n) + v(n+1)) / 2,
 // rho(n+1) = rho(n) (2 - eps) / (2 + eps) with eps = -dt drho(n+1/2) / rho(n+1/2).
-// Writes the new state, in cell order, back to the state buffers, and raises health flags.
+// Writes the new state, in cell order, back to the state buffers, and raises health flags;
+// runs over the active particles only (`parked_copy` writes the parked ones).
 // Reference: solver/src/physics/integrate.rs.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
@@ -14,12 +15,13 @@
 @group(0) @binding(8) var<storage, read_write> vel_rho_out: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
 @group(0) @binding(10) var<storage, read> regions: array<u32>;
+@group(0) @binding(11) var<storage, read> cell_starts: array<u32>;
 
 @compute @workgroup_size(128)
 fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     // An idle step (past the chunk's end, or after a blow-up) leaves the state as it is.
-    if (i >= params.n_particles || state.dt == 0.0) {
+    if (i >= cell_starts[params.n_cells] || state.dt == 0.0) {
         return;
     }
     let dt = state.dt;

@@ -1,8 +1,9 @@
 // Symplectic position-Verlet integration as in DualSPHysics, first half step:
 // x(n+1/2) = x(n) + dt/2 v(n), v(n+1/2) = v(n) + dt/2 a(n), rho(n+1/2) = rho(n) + dt/2 drho(n).
 // Walls (DBC) keep position and velocity; their density never drops below rho0 so that they
-// never pull fluid in; held sediment stays at rest; an open flume's parked particles stay
-// parked and its inlet buffer moves at the inlet velocity. Reference: solver/src/physics/integrate.rs.
+// never pull fluid in; held sediment stays at rest; an open flume's inlet buffer moves at the
+// inlet velocity. Runs over the active particles only: an open flume's parked ones sort after
+// every cell and nothing moves them. Reference: solver/src/physics/integrate.rs.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
 @group(0) @binding(2) var<storage, read> forces: array<vec4<f32>>;
@@ -12,6 +13,7 @@
 @group(0) @binding(6) var vel_rho_half: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(7) var<storage, read> regions: array<u32>;
 @group(0) @binding(8) var<storage, read> ids_n: array<u32>;
+@group(0) @binding(9) var<storage, read> cell_starts: array<u32>;
 
 // Mirrors REGION_HELD of shaders/common/sediment.wgsl.
 const REGION_HELD_BIT: u32 = 256u;
@@ -20,7 +22,7 @@ const REGION_HELD_BIT: u32 = 256u;
 fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     // An idle step (past the chunk's end, or after a blow-up) leaves the state as it is.
-    if (i >= params.n_particles || state.dt == 0.0) {
+    if (i >= cell_starts[params.n_cells] || state.dt == 0.0) {
         return;
     }
     let half_dt = 0.5 * state.dt;
@@ -30,10 +32,7 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let phase = bitcast<u32>(p.w);
     let rho = vr.w + half_dt * f.w;
     let fl = params.flume;
-    if (fl.enabled != 0u && phase == fl.parked_phase) {
-        textureStore(positions_half, texel(i), p);
-        textureStore(vel_rho_half, texel(i), vr);
-    } else if (fl.enabled != 0u && phase == fl.water_phase && p.x < fl.inlet_x_face && p.y > fl.inlet_y_min && p.y <= fl.inlet_y_max) {
+    if (fl.enabled != 0u && phase == fl.water_phase && p.x < fl.inlet_x_face && p.y > fl.inlet_y_min && p.y <= fl.inlet_y_max) {
         // The inlet buffer moves at the inlet velocity, at its density (store_state.wgsl).
         let u = vec3<f32>(fl.inlet_u, 0.0, 0.0);
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * u, p.w));

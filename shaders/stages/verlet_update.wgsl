@@ -6,7 +6,7 @@
 // rho(n+1) = rho(n) + dt drho(n) brings the two interleaved sequences back together.
 // Walls (DBC) keep position and velocity and never drop below rho0. Writes the new state,
 // in cell order, to the state buffers and the current one to `vel_rho_prev` (at rest for held
-// sediment).
+// sediment); over the active particles only (`parked_copy` writes the parked ones).
 // Reference: solver/src/physics/integrate.rs.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
@@ -20,12 +20,13 @@
 @group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
 @group(0) @binding(10) var<storage, read_write> vel_rho_prev_out: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read> regions: array<u32>;
+@group(0) @binding(12) var<storage, read> cell_starts: array<u32>;
 
 @compute @workgroup_size(128)
 fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     let dt = state.dt;
-    if (i >= params.n_particles || dt == 0.0) {
+    if (i >= cell_starts[params.n_cells] || dt == 0.0) {
         return;
     }
     let p = textureLoad(positions_n, texel(i), 0);

@@ -29,7 +29,8 @@ fn held_in_rheology(i: u32) -> bool {
 fn yield_release(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     let sd = params.sediment;
-    if (i >= params.n_particles || sd.shields_only != 0u || chunk_idle(BEFORE_DT)) {
+    // Over the active particles only, as the force pass.
+    if (i >= cell_starts[params.n_cells] || sd.shields_only != 0u || chunk_idle(BEFORE_DT)) {
         return;
     }
     let pos_i = textureLoad(positions, texel(i), 0);

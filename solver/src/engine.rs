@@ -14,6 +14,43 @@ pub struct RawState {
     pub ids: Vec<u32>,
 }
 
+/// What the open flume's inlet finds before it fills its new columns (`Engine::inlet_scan`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InletScan {
+    /// Per spot, whether a particle that is not parked is nearer to it than the radius.
+    pub occupied: Vec<bool>,
+    /// Storage slots (as `read_state` orders them) of parked particles, lowest id first, one
+    /// per spot at most.
+    pub parked_slots: Vec<usize>,
+}
+
+/// `Engine::inlet_scan` over the whole state, in storage order: the CPU backend's, and the
+/// reference of `inlet_scan.wgsl` (the same f32 test of the squared distance in x and y).
+pub fn inlet_scan(
+    positions: &[[f32; 4]],
+    ids: &[u32],
+    parked_phase: u32,
+    spots: &[[f32; 2]],
+    radius: f32,
+) -> InletScan {
+    let r2 = radius * radius;
+    let occupied = spots
+        .iter()
+        .map(|s| {
+            positions.iter().any(|p| {
+                let (dx, dy) = (p[0] - s[0], p[1] - s[1]);
+                p[3].to_bits() != parked_phase && dx * dx + dy * dy < r2
+            })
+        })
+        .collect();
+    let mut parked_slots = crate::flume::parked_slots(positions, ids, parked_phase);
+    parked_slots.truncate(spots.len());
+    InletScan {
+        occupied,
+        parked_slots,
+    }
+}
+
 /// Time spent in one stage, summed over the steps since the engine was built.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StageTime {
@@ -37,6 +74,10 @@ pub trait Engine: Send {
     /// Puts a particle into storage slot `slot` (as `read_state` orders it), at rest in both
     /// of Verlet's sequences: the open flume's inlet.
     fn place(&mut self, slot: usize, position: [f32; 4], vel_rho: [f32; 4]);
+    /// For the open flume's inlet: which of `spots` (x, y, m) a particle that is not parked is
+    /// nearer to than `radius`, and the slots of parked particles to place there, without
+    /// reading the whole state back.
+    fn inlet_scan(&mut self, spots: &[[f32; 2]], radius: f32) -> Result<InletScan, SolverError>;
     /// Region words by particle id (see `Simulation::regions`).
     fn regions(&self) -> Result<Vec<u32>, SolverError>;
     /// Forces of the current state by particle id, and the smallest stable step over

@@ -37,7 +37,6 @@ pub mod physics;
 mod backend;
 mod cpu;
 mod derived;
-mod engine;
 mod error;
 mod flume;
 mod health;
@@ -47,8 +46,10 @@ mod uniform;
 
 // Internals that the solver's tests (`solver/tests/`) reach into: stage specs, uniform
 // layouts, pipeline constants, the recovery policy, phase codes and parking spots, the
-// generator's count. Hidden from the docs; not for the node.
+// generator's count, the inlet scan's reference. Hidden from the docs; not for the node.
 
+#[doc(hidden)]
+pub mod engine;
 #[doc(hidden)]
 pub mod generate;
 #[doc(hidden)]

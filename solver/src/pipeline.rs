@@ -2,12 +2,28 @@
 //!
 //! `SphPipeline` holds the compiled stages and no particle state; `GpuBuffers` holds the
 //! state; `Bindings` ties the two together once, at setup. A step never reads back.
+//!
+//! An open flume's parked particles sort after every cell (`grid_count.wgsl`): the scan leaves
+//! the count of active particles in `cell_starts[n_cells]`, `active_dispatch` turns it into
+//! workgroup counts, and every pass after the sort is dispatched indirectly over the active
+//! particles only; `parked_copy` carries the parked ones over into the next state.
 
-use crate::gpu::buffers::{particle_texture, storage};
-use crate::gpu::params::{ScanInfo, StepState};
+use crate::gpu::GpuContext;
 use crate::gpu::stage::{Stage, groups};
-use crate::gpu::{GpuContext, GpuError};
+use crate::gpu::state::GpuBuffers;
 use crate::stages::{self, PREFIX_SUM_BLOCK};
+
+/// Workgroup sizes `active_dispatch` counts the active particles in: the neighbour passes'
+/// and the per-particle passes' (the integrators, `parked_copy`, `observe_reduce`).
+const SMALL_GROUP: u32 = 64;
+const LARGE_GROUP: u32 = 128;
+/// Byte offsets of the three (x, y, z) workgroup counts `active_dispatch` writes into
+/// `GpuBuffers::dispatch`: the active particles in small and large groups, the parked ones in
+/// large groups.
+const ACTIVE_SMALL: u64 = 0;
+const ACTIVE_LARGE: u64 = 12;
+const PARKED_LARGE: u64 = 24;
+pub const DISPATCH_BYTES: u64 = 36;
 
 /// Cells per kernel support 2h along each axis (see `shaders/common/neighbours.wgsl`): 1 or 2.
 /// Smaller cells mean fewer candidates outside the support but a four (2-D) or eight (3-D)
@@ -30,7 +46,9 @@ pub struct SphPipeline {
     prefix_sum: Stage,
     grid_scatter: Stage,
     cell_sort: Stage,
+    active_dispatch: Stage,
     reorder: Stage,
+    parked_copy: Stage,
     forces_predict: Stage,
     forces_correct: Stage,
     rheology_predict: Stage,
@@ -73,6 +91,15 @@ impl SphPipeline {
             prefix_sum: Stage::new(d, &stages::PREFIX_SUM, &[]),
             grid_scatter: Stage::new(d, &stages::GRID_SCATTER, &[]),
             cell_sort: Stage::new(d, &stages::CELL_SORT, &[]),
+            active_dispatch: Stage::new(
+                d,
+                &stages::ACTIVE_DISPATCH,
+                &[
+                    ("SMALL_GROUP", f64::from(SMALL_GROUP)),
+                    ("LARGE_GROUP", f64::from(LARGE_GROUP)),
+                ],
+            ),
+            parked_copy: Stage::new(d, &stages::PARKED_COPY, &[]),
             reorder: Stage::new(
                 d,
                 &stages::REORDER,
@@ -125,161 +152,15 @@ impl SphPipeline {
 /// of the same name in `shaders/common/particle_texture.wgsl` (checked by `shaders_validate`).
 pub const TEXEL_ROW_SHIFT: u32 = 11;
 
-/// Particle state and scratch, all resident on the GPU. `a` is the state between steps,
-/// `b` its copy in cell order at the start of a step, `c` the half-step state; `b` and `c`
-/// are textures because neighbour loops read them (see `particle_texture.wgsl`).
-pub struct GpuBuffers {
-    pub params: wgpu::Buffer,
-    pub a: StateBuffers,
-    pub b: StateTextures,
-    pub b_ids: wgpu::Buffer,
-    pub b_vel_rho_prev: wgpu::Buffer,
-    /// A copy of `a` taken at the start of each chunk, restored after a blow-up.
-    pub snapshot: StateBuffers,
-    pub c: StateTextures,
-    /// The rheology pass's viscous stress, (xx, xy, xz, yy) and (yz, zz, mu, region word), in cell
-    /// order, and region words (region | REGION_HELD) by particle id.
-    pub stress_a: wgpu::TextureView,
-    pub stress_b: wgpu::TextureView,
-    pub regions: wgpu::Buffer,
-    /// A copy of `regions` taken with `snapshot`: which sediment is held is state too.
-    pub regions_snapshot: wgpu::Buffer,
-    pub forces: wgpu::Buffer,
-    pub cell_of: wgpu::Buffer,
-    pub cell_starts: wgpu::Buffer,
-    pub cell_cursor: wgpu::Buffer,
-    pub sorted_index: wgpu::Buffer,
-    /// Per scan level: its uniform and the block sums it writes.
-    pub scan_levels: Vec<(wgpu::Buffer, wgpu::Buffer, u32)>,
-    pub state: wgpu::Buffer,
-    pub probe_points: wgpu::Buffer,
-    pub probe_sums: wgpu::Buffer,
-    pub extremes: wgpu::Buffer,
-}
-
-pub struct StateBuffers {
-    pub positions: wgpu::Buffer,
-    pub vel_rho: wgpu::Buffer,
-    pub ids: wgpu::Buffer,
-    /// Velocity and density of the step before (the Verlet integrator's second sequence).
-    pub vel_rho_prev: wgpu::Buffer,
-}
-
-pub struct StateTextures {
-    pub positions: wgpu::TextureView,
-    pub vel_rho: wgpu::TextureView,
-}
-
-impl StateTextures {
-    fn new(gpu: &GpuContext, label: &str, n: u64) -> StateTextures {
-        StateTextures {
-            positions: particle_texture(gpu, &format!("{label}.positions"), n, TEXEL_ROW_SHIFT),
-            vel_rho: particle_texture(gpu, &format!("{label}.vel_rho"), n, TEXEL_ROW_SHIFT),
-        }
-    }
-}
-
-/// Bytes of one vec4<f32> particle attribute (positions, velocity-density, forces).
-pub const VEC4_BYTES: u64 = 16;
-
-impl GpuBuffers {
-    /// Checks every large buffer against the adapter's limits before anything is allocated.
-    pub fn check_limits(gpu: &GpuContext, n_particles: u64, n_cells: u64) -> Result<(), GpuError> {
-        gpu.check_storage_size("positions", n_particles * VEC4_BYTES)?;
-        gpu.check_storage_size("cell_starts", (n_cells + 1) * 4)?;
-        let rows = n_particles.div_ceil(1 << TEXEL_ROW_SHIFT);
-        let max_rows = u64::from(gpu.limits.max_texture_dimension_2d);
-        if rows > max_rows {
-            return Err(GpuError::TooLarge {
-                buffer: "particle textures".to_string(),
-                needed_mib: (n_particles * VEC4_BYTES) as f64 / 1048576.0,
-                limit_mib: ((max_rows << TEXEL_ROW_SHIFT) * VEC4_BYTES) as f64 / 1048576.0,
-                adapter: gpu.adapter.name.clone(),
-            });
-        }
-        let max_groups = u64::from(gpu.limits.max_compute_workgroups_per_dimension);
-        if n_particles.div_ceil(u64::from(stages::FORCES_WCSPH.workgroup)) > max_groups
-            || (n_cells + 1).div_ceil(u64::from(stages::GRID_CLEAR.workgroup)) > max_groups
-        {
-            return Err(GpuError::TooLarge {
-                buffer: "dispatch size".to_string(),
-                needed_mib: (n_particles * VEC4_BYTES) as f64 / 1048576.0,
-                limit_mib: (max_groups * 64 * VEC4_BYTES) as f64 / 1048576.0,
-                adapter: gpu.adapter.name.clone(),
-            });
-        }
-        Ok(())
-    }
-
-    pub fn new(
-        gpu: &GpuContext,
-        params: wgpu::Buffer,
-        a: StateBuffers,
-        n_cells: u32,
-        n_probes: u32,
-    ) -> GpuBuffers {
-        let n = a.positions.size() / VEC4_BYTES;
-        let b = StateTextures::new(gpu, "b", n);
-        let mut scan_levels = Vec::new();
-        let mut len = n_cells + 1;
-        loop {
-            let blocks = len.div_ceil(PREFIX_SUM_BLOCK);
-            let info = crate::gpu::buffers::uniform_init(
-                gpu,
-                "scan info",
-                &ScanInfo {
-                    n: len,
-                    pad: [0; 3],
-                },
-            );
-            scan_levels.push((
-                info,
-                storage(gpu, "scan block sums", u64::from(blocks) * 4),
-                len,
-            ));
-            if blocks == 1 {
-                break;
-            }
-            len = blocks;
-        }
-        GpuBuffers {
-            params,
-            b,
-            b_ids: storage(gpu, "b.ids", n * 4),
-            b_vel_rho_prev: storage(gpu, "b.vel_rho_prev", n * VEC4_BYTES),
-            snapshot: StateBuffers {
-                positions: storage(gpu, "snapshot.positions", n * VEC4_BYTES),
-                vel_rho: storage(gpu, "snapshot.vel_rho", n * VEC4_BYTES),
-                ids: storage(gpu, "snapshot.ids", n * 4),
-                vel_rho_prev: storage(gpu, "snapshot.vel_rho_prev", n * VEC4_BYTES),
-            },
-            c: StateTextures::new(gpu, "c", n),
-            stress_a: particle_texture(gpu, "stress_a", n, TEXEL_ROW_SHIFT),
-            stress_b: particle_texture(gpu, "stress_b", n, TEXEL_ROW_SHIFT),
-            regions: storage(gpu, "regions", n * 4),
-            regions_snapshot: storage(gpu, "regions snapshot", n * 4),
-            forces: storage(gpu, "forces", n * VEC4_BYTES),
-            cell_of: storage(gpu, "cell_of", n * 4),
-            cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),
-            cell_cursor: storage(gpu, "cell_cursor", u64::from(n_cells + 1) * 4),
-            sorted_index: storage(gpu, "sorted_index", n * 4),
-            scan_levels,
-            state: storage(gpu, "step state", std::mem::size_of::<StepState>() as u64),
-            probe_points: storage(gpu, "probe points", u64::from(n_probes.max(1)) * VEC4_BYTES),
-            probe_sums: storage(gpu, "probe sums", u64::from(n_probes.max(1)) * VEC4_BYTES),
-            extremes: storage(gpu, "extremes", 16),
-            a,
-        }
-    }
-}
-
 pub struct Bindings {
     grid_clear: wgpu::BindGroup,
     grid_count: wgpu::BindGroup,
     scan: Vec<(wgpu::BindGroup, u32)>,
     grid_scatter: wgpu::BindGroup,
     cell_sort: wgpu::BindGroup,
+    active_dispatch: wgpu::BindGroup,
     reorder: wgpu::BindGroup,
+    parked_copy: wgpu::BindGroup,
     forces_predict: wgpu::BindGroup,
     forces_correct: wgpu::BindGroup,
     rheology_predict: wgpu::BindGroup,
@@ -292,6 +173,8 @@ pub struct Bindings {
     verlet_update: wgpu::BindGroup,
     probe_interpolate: wgpu::BindGroup,
     observe_reduce: wgpu::BindGroup,
+    /// Where `active_dispatch` writes the indirect dispatch arguments.
+    dispatch: wgpu::Buffer,
     n_particles: u32,
     n_cells: u32,
     n_probes: u32,
@@ -334,6 +217,25 @@ impl SphPipeline {
             cell_sort: self
                 .cell_sort
                 .bind(d, &[&g.params, &g.cell_starts, &g.a.ids, &g.sorted_index]),
+            active_dispatch: self
+                .active_dispatch
+                .bind(d, &[&g.params, &g.cell_starts, &g.dispatch]),
+            parked_copy: self.parked_copy.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.cell_starts,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.a.vel_rho_prev,
+                    &g.regions,
+                ],
+            ),
             reorder: self.reorder.bind(
                 d,
                 &[
@@ -444,6 +346,7 @@ impl SphPipeline {
                     &g.c.vel_rho,
                     &g.regions,
                     &g.b_ids,
+                    &g.cell_starts,
                 ],
             ),
             symplectic_corrector: self.symplectic_corrector.bind(
@@ -460,6 +363,7 @@ impl SphPipeline {
                     &g.a.vel_rho,
                     &g.a.ids,
                     &g.regions,
+                    &g.cell_starts,
                 ],
             ),
             verlet_update: self.verlet_update.bind(
@@ -477,6 +381,7 @@ impl SphPipeline {
                     &g.a.ids,
                     &g.a.vel_rho_prev,
                     &g.regions,
+                    &g.cell_starts,
                 ],
             ),
             probe_interpolate: self.probe_interpolate.bind(
@@ -492,16 +397,26 @@ impl SphPipeline {
                     &g.regions,
                 ],
             ),
-            observe_reduce: self
-                .observe_reduce
-                .bind(d, &[&g.params, &g.a.positions, &g.a.vel_rho, &g.extremes]),
+            observe_reduce: self.observe_reduce.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.extremes,
+                    &g.cell_starts,
+                ],
+            ),
+            dispatch: g.dispatch.clone(),
             n_particles,
             n_cells,
             n_probes,
         }
     }
 
-    /// Neighbour search: counting sort of state `a` into cells, copied in cell order into `b`.
+    /// Neighbour search: counting sort of state `a` into cells (an open flume's parked
+    /// particles after them all), copied in cell order into `b`; then the workgroup counts of
+    /// the passes over the active particles.
     pub fn record_sort(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         let n = b.n_particles;
         let cells = b.n_cells + 1;
@@ -516,40 +431,58 @@ impl SphPipeline {
             self.prefix_sum
                 .record(pass, 1, bind, groups(*len, PREFIX_SUM_BLOCK));
         }
+        self.active_dispatch.record(pass, 0, &b.active_dispatch, 1);
         self.grid_scatter.record_items(pass, 0, &b.grid_scatter, n);
+        // The parked particles' order after the cells is left to thread timing: nothing sums
+        // over them, and the host picks them by id (`inlet_scan.wgsl`).
         self.cell_sort
             .record_items(pass, 0, &b.cell_sort, b.n_cells);
         self.reorder.record_items(pass, 0, &b.reorder, n);
     }
 
+    /// Records `stage` over the active particles, in the workgroups `active_dispatch` counted.
+    fn record_active(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        b: &Bindings,
+        stage: &Stage,
+        bind: &wgpu::BindGroup,
+    ) {
+        let offset = match stage.spec.workgroup {
+            SMALL_GROUP => ACTIVE_SMALL,
+            LARGE_GROUP => ACTIVE_LARGE,
+            other => unreachable!(
+                "{} has workgroups of {other}: active_dispatch counts in {SMALL_GROUP} and {LARGE_GROUP}",
+                stage.spec.name
+            ),
+        };
+        stage.record_indirect(pass, 0, bind, &b.dispatch, offset);
+    }
+
     /// One step: sort, (rheology and) forces at n, dt, then either the symplectic predictor,
     /// (rheology and) forces at n + 1/2 and corrector, or the Verlet update (both as in
-    /// DualSPHysics).
+    /// DualSPHysics), each over the active particles; the parked ones are copied over as they are.
     pub fn record_step(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
-        let n = b.n_particles;
         self.record_sort(pass, b);
         self.record_rheology(pass, b, true);
-        self.forces_predict
-            .record_items(pass, 0, &b.forces_predict, n);
+        self.record_active(pass, b, &self.forces_predict, &b.forces_predict);
         self.dt_update.record_items(pass, 0, &b.dt_update, 1);
+        // After dt_update: on an idle step it must leave the state alone, as the integrators do.
+        self.parked_copy
+            .record_indirect(pass, 0, &b.parked_copy, &b.dispatch, PARKED_LARGE);
         if self.verlet {
-            self.verlet_update
-                .record_items(pass, 0, &b.verlet_update, n);
+            self.record_active(pass, b, &self.verlet_update, &b.verlet_update);
         } else {
-            self.symplectic_predictor
-                .record_items(pass, 0, &b.symplectic_predictor, n);
+            self.record_active(pass, b, &self.symplectic_predictor, &b.symplectic_predictor);
             self.record_rheology(pass, b, false);
-            self.forces_correct
-                .record_items(pass, 0, &b.forces_correct, n);
-            self.symplectic_corrector
-                .record_items(pass, 0, &b.symplectic_corrector, n);
+            self.record_active(pass, b, &self.forces_correct, &b.forces_correct);
+            self.record_active(pass, b, &self.symplectic_corrector, &b.symplectic_corrector);
         }
     }
 
     /// The rheology pass and the release of held sediment, on the state at n (`predict`) or
     /// at n + 1/2, when the case has them.
     fn record_rheology(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings, predict: bool) {
-        let n = b.n_particles;
         if !self.multiphase {
             return;
         }
@@ -558,14 +491,14 @@ impl SphPipeline {
         } else {
             (&self.rheology_correct, &b.rheology_correct)
         };
-        rheology.record_items(pass, 0, bind, n);
+        self.record_active(pass, b, rheology, bind);
         if self.yield_release {
             let (release, bind) = if predict {
                 (&self.release_predict, &b.release_predict)
             } else {
                 (&self.release_correct, &b.release_correct)
             };
-            release.record_items(pass, 0, bind, n);
+            self.record_active(pass, b, release, bind);
         }
     }
 
@@ -573,16 +506,15 @@ impl SphPipeline {
     pub fn record_forces(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
         self.record_rheology(pass, b, true);
-        self.forces_predict
-            .record_items(pass, 0, &b.forces_predict, b.n_particles);
+        self.record_active(pass, b, &self.forces_predict, &b.forces_predict);
     }
 
-    /// Observation passes: probe sums on the sorted state and the whole-state maxima.
+    /// Observation passes: probe sums on the sorted state and the maxima over its active
+    /// particles.
     pub fn record_observe(&self, pass: &mut wgpu::ComputePass<'_>, b: &Bindings) {
         self.record_sort(pass, b);
         self.probe_interpolate
             .record_items(pass, 0, &b.probe_interpolate, b.n_probes);
-        self.observe_reduce
-            .record_items(pass, 0, &b.observe_reduce, b.n_particles);
+        self.record_active(pass, b, &self.observe_reduce, &b.observe_reduce);
     }
 }

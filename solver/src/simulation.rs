@@ -8,7 +8,7 @@ use crate::config::{Case, Integrator, Viscosity, YieldCriterion};
 use crate::derived::{Derived, MAX_INLET_MACH, check_inflow, derive, max_inflow_m3_per_s};
 use crate::engine::{Engine, StageTime};
 use crate::error::SolverError;
-use crate::flume::{BoundaryConditions, FlumeState, parked_slots};
+use crate::flume::{BoundaryConditions, FlumeState};
 use crate::generate::{count, generate};
 use crate::gpu::engine::{GpuEngine, PipelineShape, by_id};
 use crate::gpu::params::*;
@@ -103,7 +103,7 @@ impl Simulation {
             return Err(SolverError::TooManyParticles(count));
         }
         if let Backend::Gpu(gpu) = &backend {
-            crate::pipeline::GpuBuffers::check_limits(gpu, count, n_cells)?;
+            crate::gpu::state::GpuBuffers::check_limits(gpu, count, n_cells)?;
         }
         check_inflow(case)?;
         let particles = generate(case, &derived);
@@ -469,7 +469,9 @@ impl Simulation {
         self.derived.phases.iter().map(|p| p.rho0).collect()
     }
 
-    /// Fills the inlet columns due after `span_s` more of inflow with parked particles.
+    /// Fills the inlet columns due after `span_s` more of inflow with parked particles, lowest
+    /// id first. The backend answers which spots are taken and which slots to fill in one
+    /// small scan (`Engine::inlet_scan`): the state is not read back.
     fn feed_inlet(&mut self, span_s: f64) -> Result<(), SolverError> {
         let dp = self.case.numerics.dp_m;
         let x_min = self.case.domain.min_m[0];
@@ -481,38 +483,33 @@ impl Simulation {
             return Ok(());
         }
         let heights = f.column_heights(dp);
+        let spots: Vec<[f32; 2]> = injection
+            .columns_x_m
+            .iter()
+            .flat_map(|&x| heights.iter().map(move |&y| [x as f32, y as f32]))
+            .collect();
         let u = f.inlet_velocity() as f32;
-        let raw = self.engine.read_state()?;
-        let (positions, ids) = (raw.positions, raw.ids);
         let fl = self.params.flume;
         // The buffer keeps the density its particles enter with (store_state.wgsl): rest.
         let rho = self.params.phases[fl.water_phase as usize].rho0;
-        let mut free = parked_slots(&positions, &ids, fl.parked_phase).into_iter();
+        // A spot some particle has wandered into (within dp / 2) stays empty this time: a
+        // particle placed on top of another would send both densities out of range.
+        let scan = self.engine.inlet_scan(&spots, (0.5 * dp) as f32)?;
+        let mut free = scan.parked_slots.into_iter();
         let mut starved = 0u64;
         let mut placed = 0u64;
-        // A spot some particle has wandered into stays empty this time: a particle placed on
-        // top of another would send both densities out of range.
-        let occupied = |x: f64, y: f64| {
-            let r2 = (0.5 * dp) * (0.5 * dp);
-            positions.iter().any(|p| {
-                let (dx, dy) = (f64::from(p[0]) - x, f64::from(p[1]) - y);
-                p[3].to_bits() != fl.parked_phase && dx * dx + dy * dy < r2
-            })
-        };
-        for &x in &injection.columns_x_m {
-            for &y in &heights {
-                if occupied(x, y) {
-                    f.blocked_particles += 1;
-                    continue;
-                }
-                let Some(slot) = free.next() else {
-                    starved += 1;
-                    continue;
-                };
-                let pos = [x as f32, y as f32, 0.0, f32::from_bits(fl.water_phase)];
-                self.engine.place(slot, pos, [u, 0.0, 0.0, rho]);
-                placed += 1;
+        for (spot, occupied) in spots.iter().zip(scan.occupied) {
+            if occupied {
+                f.blocked_particles += 1;
+                continue;
             }
+            let Some(slot) = free.next() else {
+                starved += 1;
+                continue;
+            };
+            let pos = [spot[0], spot[1], 0.0, f32::from_bits(fl.water_phase)];
+            self.engine.place(slot, pos, [u, 0.0, 0.0, rho]);
+            placed += 1;
         }
         f.parked_particles = f.parked_particles.saturating_sub(placed);
         f.injected_particles += placed;
@@ -605,6 +602,20 @@ impl Simulation {
     /// The cell list of the current state: (cell starts, particle ids in sorted order).
     pub fn cell_list(&self) -> Result<(Vec<u32>, Vec<u32>), SolverError> {
         self.engine.cell_list()
+    }
+
+    /// Which of `spots` (x, y, m) a particle that is not parked is nearer to than `radius`, and
+    /// the ids of the parked particles the inlet would fill them with, lowest first: the
+    /// backend's side of the inlet test.
+    pub fn inlet_scan(
+        &mut self,
+        spots: &[[f32; 2]],
+        radius: f32,
+    ) -> Result<(Vec<bool>, Vec<u32>), SolverError> {
+        let scan = self.engine.inlet_scan(spots, radius)?;
+        let ids = self.engine.read_state()?.ids;
+        let parked = scan.parked_slots.iter().map(|&k| ids[k]).collect();
+        Ok((scan.occupied, parked))
     }
 
     pub fn params(&self) -> &SimParams {

@@ -117,6 +117,20 @@ pub const CELL_SORT: StageSpec = StageSpec {
     workgroup: 128,
 };
 
+/// Indirect dispatch arguments from the active count; see `pipeline::Indirect`.
+pub const ACTIVE_DISPATCH: StageSpec = StageSpec {
+    name: "active_dispatch",
+    shader: "stages/active_dispatch.wgsl",
+    imports: &["common/params.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("cell_starts", 1, Read),
+        ("dispatch", 2, ReadWrite),
+    ],
+    entry_points: &["active_dispatch"],
+    workgroup: 1,
+};
+
 pub const REORDER: StageSpec = StageSpec {
     name: "reorder",
     shader: "stages/reorder.wgsl",
@@ -134,6 +148,31 @@ pub const REORDER: StageSpec = StageSpec {
         ("sorted_vel_rho_prev", 9, ReadWrite),
     ],
     entry_points: &["reorder"],
+    workgroup: 128,
+};
+
+pub const PARKED_COPY: StageSpec = StageSpec {
+    name: "parked_copy",
+    shader: "stages/parked_copy.wgsl",
+    imports: &[
+        "common/params.wgsl",
+        "common/particle_texture.wgsl",
+        "common/step_state.wgsl",
+    ],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("state", 1, ReadWrite),
+        ("cell_starts", 2, Read),
+        ("positions_n", 3, Texture),
+        ("vel_rho_n", 4, Texture),
+        ("ids_n", 5, Read),
+        ("positions_out", 6, ReadWrite),
+        ("vel_rho_out", 7, ReadWrite),
+        ("ids_out", 8, ReadWrite),
+        ("vel_rho_prev_out", 9, ReadWrite),
+        ("regions", 10, ReadWrite),
+    ],
+    entry_points: &["parked_copy"],
     workgroup: 128,
 };
 
@@ -216,6 +255,7 @@ pub const SYMPLECTIC_PREDICTOR: StageSpec = StageSpec {
         ("vel_rho_half", 6, TextureWrite),
         ("regions", 7, Read),
         ("ids_n", 8, Read),
+        ("cell_starts", 9, Read),
     ],
     entry_points: &["symplectic_predictor"],
     workgroup: 128,
@@ -237,6 +277,7 @@ pub const SYMPLECTIC_CORRECTOR: StageSpec = StageSpec {
         ("vel_rho_out", 8, ReadWrite),
         ("ids_out", 9, ReadWrite),
         ("regions", 10, Read),
+        ("cell_starts", 11, Read),
     ],
     entry_points: &["symplectic_corrector"],
     workgroup: 128,
@@ -259,6 +300,7 @@ pub const VERLET_UPDATE: StageSpec = StageSpec {
         ("ids_out", 9, ReadWrite),
         ("vel_rho_prev_out", 10, ReadWrite),
         ("regions", 11, Read),
+        ("cell_starts", 12, Read),
     ],
     entry_points: &["verlet_update"],
     workgroup: 128,
@@ -285,14 +327,35 @@ pub const PROBE_INTERPOLATE: StageSpec = StageSpec {
 pub const OBSERVE_REDUCE: StageSpec = StageSpec {
     name: "observe_reduce",
     shader: "stages/observe_reduce.wgsl",
+    imports: &["common/params.wgsl", "common/particle_texture.wgsl"],
+    bindings: &[
+        ("params", 0, Uniform),
+        ("positions", 1, Texture),
+        ("vel_rho", 2, Texture),
+        ("extremes", 3, ReadWrite),
+        ("cell_starts", 4, Read),
+    ],
+    entry_points: &["observe_reduce"],
+    workgroup: 128,
+};
+
+/// The open flume's inlet: occupied spots and parked slots (`Engine::inlet_scan`).
+pub const INLET_SCAN: StageSpec = StageSpec {
+    name: "inlet_scan",
+    shader: "stages/inlet_scan.wgsl",
     imports: &["common/params.wgsl"],
     bindings: &[
         ("params", 0, Uniform),
-        ("positions", 1, Read),
-        ("vel_rho", 2, Read),
-        ("extremes", 3, ReadWrite),
+        ("query", 1, Uniform),
+        ("positions", 2, Read),
+        ("ids", 3, Read),
+        ("spots", 4, Read),
+        ("occupied", 5, ReadWrite),
+        ("parked_bits", 6, ReadWrite),
+        ("slot_of", 7, ReadWrite),
+        ("picks", 8, ReadWrite),
     ],
-    entry_points: &["observe_reduce"],
+    entry_points: &["inlet_mark", "inlet_pick"],
     workgroup: 128,
 };
 
@@ -303,7 +366,9 @@ pub const ALL: &[&StageSpec] = &[
     &PREFIX_SUM,
     &GRID_SCATTER,
     &CELL_SORT,
+    &ACTIVE_DISPATCH,
     &REORDER,
+    &PARKED_COPY,
     &FORCES_WCSPH,
     &RHEOLOGY,
     &YIELD_RELEASE,
@@ -313,4 +378,5 @@ pub const ALL: &[&StageSpec] = &[
     &VERLET_UPDATE,
     &PROBE_INTERPOLATE,
     &OBSERVE_REDUCE,
+    &INLET_SCAN,
 ];

@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::parked;
 use common::stages::{self, case};
 use flume_solver::Backend;
 
@@ -66,4 +67,14 @@ fn rheology_matches_the_oracle_drucker_prager_shields() {
 #[test]
 fn rheology_matches_the_oracle_shields_only() {
     stages::check_rheology(&CPU, stages::shields_only_case(), 22);
+}
+
+#[test]
+fn parked_particles_sort_after_every_cell_and_take_no_part() {
+    parked::check_parked_take_no_part(&CPU);
+}
+
+#[test]
+fn inlet_scan_matches_a_scan_of_the_whole_state() {
+    parked::check_inlet_scan(&CPU);
 }

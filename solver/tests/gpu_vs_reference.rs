@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::parked;
 use common::stages::{self, case};
 
 /// Runs a shared stage check on the GPU, one GPU test at a time.
@@ -70,4 +71,14 @@ fn rheology_matches_the_cpu_drucker_prager_shields() {
 #[test]
 fn rheology_matches_the_cpu_shields_only() {
     on_gpu(|b| stages::check_rheology(b, stages::shields_only_case(), 22));
+}
+
+#[test]
+fn parked_particles_sort_after_every_cell_and_take_no_part() {
+    on_gpu(parked::check_parked_take_no_part);
+}
+
+#[test]
+fn inlet_scan_matches_a_scan_of_the_whole_state() {
+    on_gpu(parked::check_inlet_scan);
 }

@@ -2,7 +2,8 @@
 //! workgroup size match the WGSL, and the Rust mirrors of WGSL structs have naga's layout.
 
 use flume_solver::gpu::params::{
-    ExcludedParticle, Extremes, FlumeGpu, PhaseParams, ScanInfo, SedimentGpu, SimParams, StepState,
+    ExcludedParticle, Extremes, FlumeGpu, InletQuery, PhaseParams, ScanInfo, SedimentGpu,
+    SimParams, StepState,
 };
 use flume_solver::gpu::stage::Access;
 use flume_solver::stages::ALL;
@@ -310,4 +311,12 @@ fn rust_mirrors_have_the_wgsl_layout() {
         .expect("scan stage");
     let (_, size) = wgsl_layout(&parse("prefix_sum", &scan.source()), "ScanInfo");
     assert_eq!(size as usize, size_of::<ScanInfo>());
+
+    let inlet = ALL
+        .iter()
+        .find(|s| s.name == "inlet_scan")
+        .expect("inlet stage");
+    let (m, size) = wgsl_layout(&parse("inlet_scan", &inlet.source()), "InletQuery");
+    assert_eq!(size as usize, size_of::<InletQuery>());
+    same!(InletQuery, m, n_spots, radius2);
 }

@@ -15,7 +15,7 @@ mod observe;
 mod step;
 mod store;
 
-use crate::engine::{Engine, RawState, StageTime};
+use crate::engine::{Engine, InletScan, RawState, StageTime};
 use crate::error::SolverError;
 use crate::gpu::engine::{PipelineShape, by_id};
 use crate::gpu::params::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
@@ -186,6 +186,12 @@ impl Engine for CpuEngine {
         self.a.positions[slot] = position;
         self.a.vel_rho[slot] = vel_rho;
         self.a.vel_rho_prev[slot] = vel_rho;
+    }
+
+    fn inlet_scan(&mut self, spots: &[[f32; 2]], radius: f32) -> Result<InletScan, SolverError> {
+        let (a, parked) = (&self.a, self.params.flume.parked_phase);
+        let scan = crate::engine::inlet_scan(&a.positions, &a.ids, parked, spots, radius);
+        Ok(scan)
     }
 
     fn regions(&self) -> Result<Vec<u32>, SolverError> {

@@ -14,6 +14,16 @@ pub fn storage(gpu: &GpuContext, label: &str, bytes: u64) -> wgpu::Buffer {
     })
 }
 
+/// A storage buffer a stage writes indirect dispatch arguments into.
+pub fn indirect(gpu: &GpuContext, label: &str, bytes: u64) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+        mapped_at_creation: false,
+    })
+}
+
 pub fn storage_init<T: bytemuck::Pod>(gpu: &GpuContext, label: &str, data: &[T]) -> wgpu::Buffer {
     let bytes: &[u8] = bytemuck::cast_slice(data);
     if bytes.len() < 16 {

@@ -3,11 +3,13 @@
 
 use super::GpuContext;
 use super::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
+use super::inlet::InletScanner;
 use super::params::{Extremes, SimParams, StepState};
-use crate::engine::{Engine, RawState, StageTime};
+use super::state::{GpuBuffers, StateBuffers};
+use crate::engine::{Engine, InletScan, RawState, StageTime};
 use crate::error::SolverError;
 use crate::particles::Particles;
-use crate::pipeline::{Bindings, GpuBuffers, SphPipeline, StateBuffers};
+use crate::pipeline::{Bindings, SphPipeline};
 use std::sync::Arc;
 
 /// Which optional stages a case's pipeline has.
@@ -25,6 +27,8 @@ pub struct GpuEngine {
     pipeline: SphPipeline,
     buffers: GpuBuffers,
     bindings: Bindings,
+    /// The open flume's inlet stage, built on the first call.
+    inlet: Option<InletScanner>,
     n: u64,
     n_probes: u64,
     n_cells: u64,
@@ -69,6 +73,7 @@ impl GpuEngine {
             pipeline,
             buffers,
             bindings,
+            inlet: None,
             n: u64::from(n),
             n_probes: u64::from(params.n_probes),
             n_cells: u64::from(params.n_cells),
@@ -182,6 +187,12 @@ impl Engine for GpuEngine {
         q.write_buffer(&a.vel_rho_prev, offset, bytemuck::bytes_of(&vel_rho));
     }
 
+    fn inlet_scan(&mut self, spots: &[[f32; 2]], radius: f32) -> Result<InletScan, SolverError> {
+        let gpu = &self.gpu;
+        let scanner = self.inlet.get_or_insert_with(|| InletScanner::new(gpu));
+        scanner.scan(gpu, &self.buffers, self.n as u32, spots, radius)
+    }
+
     fn regions(&self) -> Result<Vec<u32>, SolverError> {
         let raw = read_buffers(&self.gpu, &[(&self.buffers.regions, self.n * 4)])?;
         Ok(cast_vec(&raw[0]))
@@ -190,6 +201,10 @@ impl Engine for GpuEngine {
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
         self.write_state(&StepState::chunk(f32::MAX, 0.0, 0.0, 0));
+        // The pass writes the active particles only: parked ones feel nothing.
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&self.buffers.forces, 0, None);
+        self.gpu.queue.submit([encoder.finish()]);
         self.submit(|pass| self.pipeline.record_forces(pass, &self.bindings));
         let b = &self.buffers;
         let raw = read_buffers(

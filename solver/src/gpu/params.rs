@@ -197,6 +197,16 @@ pub struct ScanInfo {
     pub pad: [u32; 3],
 }
 
+/// Mirrors `InletQuery` in `shaders/stages/inlet_scan.wgsl`: the inlet's spots to check and
+/// the square of the distance within which a particle occupies one, m2.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct InletQuery {
+    pub n_spots: u32,
+    pub radius2: f32,
+    pub pad: [u32; 2],
+}
+
 /// Maps f32 to u32 so that unsigned order is float order (negative values too); mirrors the
 /// shader's `order_key` in observe_reduce.wgsl.
 pub fn order_key(x: f32) -> u32 {

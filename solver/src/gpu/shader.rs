@@ -28,7 +28,9 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "stages/prefix_sum.wgsl",
     "stages/grid_scatter.wgsl",
     "stages/cell_sort.wgsl",
+    "stages/active_dispatch.wgsl",
     "stages/reorder.wgsl",
+    "stages/parked_copy.wgsl",
     "stages/forces_wcsph.wgsl",
     "stages/rheology.wgsl",
     "stages/yield_release.wgsl",
@@ -38,6 +40,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "stages/verlet_update.wgsl",
     "stages/probe_interpolate.wgsl",
     "stages/observe_reduce.wgsl",
+    "stages/inlet_scan.wgsl",
 ];
 
 pub fn source(path: &str) -> &'static str {

@@ -170,6 +170,21 @@ impl Stage {
         pass.set_bind_group(0, bind, &[]);
         pass.dispatch_workgroups(groups, 1, 1);
     }
+
+    /// Records one dispatch of entry point `entry` whose workgroup counts a stage wrote into
+    /// `args` at byte `offset` (three u32: x, y, z).
+    pub fn record_indirect(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        entry: usize,
+        bind: &wgpu::BindGroup,
+        args: &wgpu::Buffer,
+        offset: u64,
+    ) {
+        pass.set_pipeline(&self.pipelines[entry]);
+        pass.set_bind_group(0, bind, &[]);
+        pass.dispatch_workgroups_indirect(args, offset);
+    }
 }
 
 fn binding_type(access: Access) -> wgpu::BindingType {

@@ -2,6 +2,7 @@
 
 #![allow(dead_code)]
 
+pub mod parked;
 pub mod stages;
 
 use flume_solver::{Backend, GpuContext};
