@@ -5,7 +5,6 @@
 //! the state alone: runs are bit-identical whatever came before and on any number of threads.
 
 use crate::gpu::params::SimParams;
-use rayon::prelude::*;
 use std::ops::Range;
 
 pub struct Grid {
@@ -50,12 +49,12 @@ impl Grid {
     }
 
     /// Sorts particles by (cell, id): returns, for each sorted slot, the storage index of its
-    /// particle, and fills `starts`; the cells are found on the calling thread pool. Particles of phase `parked` (an open flume's reservoir)
+    /// particle, and fills `starts`. Particles of phase `parked` (an open flume's reservoir)
     /// go after all cells, in storage order: no neighbour loop visits them.
     pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32], parked: Option<u32>) -> Vec<u32> {
         let outside = self.starts.len() as u32 - 1;
         let cells: Vec<u32> = positions
-            .par_iter()
+            .iter()
             .map(|p| {
                 if Some(p[3].to_bits()) == parked {
                     outside
@@ -122,5 +121,5 @@ impl Grid {
 
 /// `values` in sorted order: slot k holds the value of storage index `order[k]`.
 pub fn gather<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
-    order.par_iter().map(|&i| values[i as usize]).collect()
+    order.iter().map(|&i| values[i as usize]).collect()
 }

@@ -21,26 +21,21 @@ impl CpuEngine {
     /// Sorts the state into cells: the sorted copy and its grid.
     pub(super) fn sorted(&self) -> (Grid, State) {
         let mut grid = self.grid();
-        self.pool.install(|| {
-            let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
-            let b = self.a.gather(&order);
-            (grid, b)
-        })
+        let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
+        (grid, self.a.gather(&order))
     }
 
     /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
     fn holds(&self, b: &State) -> Vec<bool> {
         let phases = &self.model.phases;
-        self.pool.install(|| {
-            b.positions
-                .par_iter()
-                .zip(&b.ids)
-                .map(|(x, &id)| {
-                    phases[x[3].to_bits() as usize].mobile
-                        && self.regions[id as usize] & REGION_HELD != 0
-                })
-                .collect()
-        })
+        b.positions
+            .iter()
+            .zip(&b.ids)
+            .map(|(x, &id)| {
+                phases[x[3].to_bits() as usize].mobile
+                    && self.regions[id as usize] & REGION_HELD != 0
+            })
+            .collect()
     }
 
     /// (Rheology and release, then) forces and stable steps of the active particles of `b`
@@ -224,25 +219,24 @@ impl CpuEngine {
         ids: Vec<u32>,
         stored: Vec<(Particle, [f32; 4], Event)>,
     ) {
-        let ((positions, vel_rho), (vel_rho_prev, events)): Parts = self.pool.install(|| {
-            stored
-                .into_par_iter()
-                .map(|((x, v), prev, event)| ((x, v), (prev, event)))
-                .unzip()
-        });
-        tally(st, &events);
-        self.a = State {
-            positions,
-            vel_rho,
+        let n = stored.len();
+        let mut next = State {
+            positions: Vec::with_capacity(n),
+            vel_rho: Vec::with_capacity(n),
             ids,
-            vel_rho_prev,
+            vel_rho_prev: Vec::with_capacity(n),
         };
+        let mut events = Vec::with_capacity(n);
+        for ((x, v), prev, event) in stored {
+            next.positions.push(x);
+            next.vel_rho.push(v);
+            next.vel_rho_prev.push(prev);
+            events.push(event);
+        }
+        tally(st, &events);
+        self.a = next;
     }
 }
-
-/// A step's particles taken apart: positions, velocities and densities (now and before),
-/// and events.
-type Parts = ((Vec<[f32; 4]>, Vec<[f32; 4]>), (Vec<[f32; 4]>, Vec<Event>));
 
 /// The variable time step of `dt_update.wgsl`: dt = CFL min(dt_force, dt_sound, dt_visc),
 /// landing exactly on the chunk's target time; zero once the chunk is over.
