@@ -206,15 +206,13 @@ impl<'a> PairModel<'a> {
         if !phase_i.mobile {
             return None;
         }
-        // One division for the two terms over r^2 + eta^2.
-        let inv_r2_eta2 = 1.0 / (r2 + self.eta2);
         if params.delta > 0.0 && phase_j.mobile && j.phase == i.phase {
             // Same phase, not a wall: j's own mass and density, hence its own volume.
-            sum.drho += self.delta_h_c0 * self.diffusion(i, j, r2, f, inv_r2_eta2) * j.vol;
+            sum.drho += self.delta_h_c0 * self.diffusion(i, j, r2, f) * j.vol;
         }
         // Pressure gradient, Eq. 10 with sigma = -p I.
         let mut coef = -m_j * (i.p_over_rho2 + p_j);
-        let mu_ij = h * vdotr * inv_r2_eta2;
+        let mu_ij = h * vdotr / (r2 + self.eta2);
         sum.visc_max = sum.visc_max.max(mu_ij.abs());
         match params.viscosity {
             Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } => {
@@ -229,7 +227,8 @@ impl<'a> PairModel<'a> {
             }
             Viscosity::Laminar => {
                 // x_ij . grad_i W_ij = r2 F.
-                let s = m_j * (phase_i.mu + phase_j.mu) * (r2 * f) * inv_r2_eta2 / (i.rho * rho_j);
+                let s =
+                    m_j * (phase_i.mu + phase_j.mu) * (r2 * f) / (i.rho * rho_j * (r2 + self.eta2));
                 for k in 0..3 {
                     sum.acc[k] += coef * f * x_ij[k] + s * v_ij[k];
                 }
@@ -242,9 +241,8 @@ impl<'a> PairModel<'a> {
     /// difference rho_h is subtracted so that a fluid at rest under gravity is not diffused
     /// towards uniform density. rho_h = rho0 ((1 + x)^(1/7) - 1), x = rho0 g dz / B, by its
     /// series: x is below 1e-3 for neighbours (dz < 2h), where three terms are exact in f32.
-    /// `inv_r2_eta2` is 1 / (r^2 + eta^2).
     #[inline(always)]
-    fn diffusion(&self, i: &Side, j: &Side, r2: f32, f: f32, inv_r2_eta2: f32) -> f32 {
+    fn diffusion(&self, i: &Side, j: &Side, r2: f32, f: f32) -> f32 {
         let rho_h = if self.params.hydrostatic_diffusion {
             let phase = self.phase(i.phase);
             let rho0 = phase.rho0;
@@ -253,7 +251,7 @@ impl<'a> PairModel<'a> {
         } else {
             0.0
         };
-        2.0 * (j.rho - i.rho - rho_h) * (-r2 * f) * inv_r2_eta2
+        2.0 * (j.rho - i.rho - rho_h) * (-r2 * f) / (r2 + self.eta2)
     }
 
     /// Particle `i`'s `[ax, ay, az, d rho/dt]` (gravity added; zero acceleration for a wall)

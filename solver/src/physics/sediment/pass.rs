@@ -242,10 +242,9 @@ impl<'a> Rheology<'a> {
         let du = sub3(v_j, v_i);
         // In 2-D the third row and column are zero: the loops stop at the dimension.
         let dim = self.params.dim as usize;
-        let weight = vol_j * f;
         for (row, d) in s.grad.iter_mut().zip(du).take(dim) {
             for (g, x) in row.iter_mut().zip(x_ij).take(dim) {
-                *g += weight * d * x;
+                *g += vol_j * d * x * f;
             }
         }
         let model = self.model;
@@ -457,11 +456,10 @@ impl<'a> StressDivergence<'a> {
     pub fn add_term(&self, i: &StressSide, j: &StressSide, g: &PairGeometry, acc: &mut [f32; 3]) {
         // In 2-D the third row and column are zero: the loops stop at the dimension.
         let dim = self.params.dim as usize;
-        let weight = g.m_j * g.f;
         let rows = acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2);
         for ((a, t_i), t_j) in rows.take(dim) {
             for ((ti, tj), x) in t_i.iter().zip(t_j).zip(g.x_ij).take(dim) {
-                *a += weight * (ti + tj) * x;
+                *a += g.m_j * (ti + tj) * x * g.f;
             }
         }
     }
