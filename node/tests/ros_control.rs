@@ -111,9 +111,30 @@ where
     .flatten()
 }
 
+/// The twin's services were not matched by this side's participant within a minute.
+struct Unmatched;
+
+/// RustDDS on loopback has, rarely, never matched the twin's services with this side's
+/// participant: the wait timed out after two minutes (twice on a loaded machine, once in a
+/// whole suite on an idle one) where a run takes 7 s, and the same test then passed alone
+/// every time. What this test checks is
+/// the services, not discovery, so it starts again once with a new twin and a new
+/// participant, and says so; a second miss fails.
 #[test]
 fn parameters_and_services_from_another_process_control_the_twin() {
     let Some(_gpu) = gpu() else { return };
+    if control_the_twin().is_err() {
+        eprintln!(
+            "the twin's services were never matched (RustDDS discovery): starting again with a new twin and a new participant"
+        );
+        assert!(
+            control_the_twin().is_ok(),
+            "the twin's services were never matched, twice"
+        );
+    }
+}
+
+fn control_the_twin() -> Result<(), Unmatched> {
     let mut twin = Twin(
         Command::new(env!("CARGO_BIN_EXE_flume-twin"))
             .args([
@@ -229,6 +250,9 @@ fn parameters_and_services_from_another_process_control_the_twin() {
             .create_subscription::<GaugeComparison>(&compare_topic, Some(compare_qos))
             .expect("subscription");
 
+        tokio::time::timeout(Duration::from_secs(60), setter.wait_for_service(&node))
+            .await
+            .map_err(|_| Unmatched)?;
         let refused = call(
             &node,
             &setter,
@@ -361,5 +385,6 @@ fn parameters_and_services_from_another_process_control_the_twin() {
             seen.1
         );
         assert!((seen.3 - (seen.2 - seen.1)).abs() < 1e-12);
-    });
+        Ok(())
+    })
 }
