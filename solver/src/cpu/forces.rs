@@ -1,11 +1,15 @@
 //! The force pass of the CPU backend: each particle sums its neighbours' pair terms
 //! (`PairModel::add_pair`, the one statement of the formulas) over the contiguous rows of the
-//! cell list, particles shared out among threads in blocks. Each sum is taken by one thread in
-//! sorted order, so the result does not depend on the number of threads.
+//! cell list, particles shared out among threads in blocks. A block is taken in groups of up
+//! to [`LANES`] particles of one row of cells, each neighbour against the whole group at once
+//! (`physics::lanes`); every lane sums its own neighbours in sorted order, as one particle
+//! alone would, so the result does not depend on the grouping or on the number of threads.
 
-use super::grid::Grid;
+use super::grid::{Grid, Group};
+use super::simd;
 use crate::physics::interaction::{PairModel, PairSum, Side};
-use crate::physics::sediment::pass::{StressDivergence, StressSide};
+use crate::physics::lanes::{Lanes, Real};
+use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
 use rayon::prelude::*;
 
@@ -23,6 +27,14 @@ pub struct Extra<'a> {
     pub imposed: &'a [bool],
 }
 
+/// What one block of the pass reads.
+struct Pass<'a> {
+    model: &'a PairModel<'a>,
+    grid: &'a Grid,
+    sides: &'a [Side],
+    extra: &'a Extra<'a>,
+}
+
 /// Fills `forces` (`[ax, ay, az, d rho/dt]`) and `dt_limit` (the stable step before the CFL
 /// factor) of each particle of `sides`, in sorted order; cells come from `grid`, whose
 /// starts were sorted from the same particles or from the state half a step before.
@@ -35,50 +47,186 @@ pub fn force_pass(
     forces: &mut [[f32; 4]],
     dt_limit: &mut [f32],
 ) {
-    let h = model.params().h;
+    let pass = Pass {
+        model,
+        grid,
+        sides,
+        extra,
+    };
     pool.install(|| {
         forces
             .par_chunks_mut(BLOCK)
             .zip(dt_limit.par_chunks_mut(BLOCK))
             .enumerate()
             .for_each(|(block, (forces, dt_limit))| {
-                let first = block * BLOCK;
-                for (k, (f, dt)) in forces.iter_mut().zip(dt_limit).enumerate() {
-                    let i = first + k;
-                    let side = &sides[i];
-                    let mut sum = PairSum::default();
-                    let mut tau = [0.0f32; 3];
-                    grid.rows(grid.coords(&side.x), |range| match extra.stress {
-                        None => {
-                            for j in range {
-                                model.add_pair(side, &sides[j], &mut sum);
-                            }
-                        }
-                        Some((div, stress, _)) => {
-                            for j in range {
-                                if let Some(g) = model.add_pair(side, &sides[j], &mut sum) {
-                                    div.add_term(&stress[i], &stress[j], &g, &mut tau);
-                                }
-                            }
-                        }
-                    });
-                    for (a, t) in sum.acc.iter_mut().zip(tau) {
-                        *a += t;
-                    }
-                    let imposed = extra.imposed.get(i).copied().unwrap_or(false);
-                    (*f, *dt) = model.finish(side, &sum, !imposed);
-                    if let Some((_, _, mu)) = extra.stress
-                        && dt.is_finite()
-                    {
-                        *dt = dt.min(particle_viscous_bound(h, side.rho, mu[i]));
-                    }
-                }
+                simd::dispatch(|| pass.block(block * BLOCK, forces, dt_limit));
             });
     });
+}
+
+impl Pass<'_> {
+    /// The particles of one block, from sorted index `first`, group by group.
+    #[inline(always)]
+    fn block(&self, first: usize, forces: &mut [[f32; 4]], dt_limit: &mut [f32]) {
+        let end = first + forces.len();
+        let mut start = first;
+        while start < end {
+            let group = self.grid.group(start, end, |k| self.sides[k].x);
+            let (sum, tau) = self.group(&group);
+            for (lane, i) in group.range.clone().enumerate() {
+                let mut s = sum.lane(lane);
+                for (a, t) in s.acc.iter_mut().zip(tau) {
+                    *a += t.0[lane];
+                }
+                let (f, dt) = self.finish(i, &s);
+                forces[i - first] = f;
+                dt_limit[i - first] = dt;
+            }
+            start = group.range.end;
+        }
+    }
+
+    /// The pair sums of `group` and, with the multiphase model, its stress divergence.
+    #[inline(always)]
+    fn group(&self, group: &Group) -> (PairSum<Lanes>, [Lanes; 3]) {
+        let (grid, model, sides) = (self.grid, self.model, self.sides);
+        let side = Side::lanes(&sides[group.range.clone()]);
+        let reach = grid.reach();
+        let mut sum = PairSum::<Lanes>::default();
+        let mut tau = [Lanes::splat(0.0); 3];
+        let stress = self.extra.stress.map(|(div, stress, _)| {
+            let mine = StressSide::lanes(&stress[group.range.clone()]);
+            (div, stress, mine)
+        });
+        grid.row_span(group.cell, group.last_x(), |range, x| {
+            let near = group.near(x, reach);
+            match &stress {
+                None => {
+                    for j in range {
+                        model.add_pair(&side, &sides[j], near, &mut sum);
+                    }
+                }
+                Some((div, stress, stress_i)) => {
+                    for j in range {
+                        if let Some(g) = model.add_pair(&side, &sides[j], near, &mut sum) {
+                            div.add_term(stress_i, &stress[j], &g, &mut tau);
+                        }
+                    }
+                }
+            }
+        });
+        (sum, tau)
+    }
+
+    /// Particle `i`'s forces and step from its sums.
+    fn finish(&self, i: usize, sum: &PairSum) -> ([f32; 4], f32) {
+        let side = &self.sides[i];
+        let imposed = self.extra.imposed.get(i).copied().unwrap_or(false);
+        let (f, mut dt) = self.model.finish(side, sum, !imposed);
+        if let Some((_, _, mu)) = self.extra.stress
+            && dt.is_finite()
+        {
+            dt = dt.min(particle_viscous_bound(
+                self.model.params().h,
+                side.rho,
+                mu[i],
+            ));
+        }
+        (f, dt)
+    }
 }
 
 /// The smallest stable step over particles, s (f32::MAX when none bounds it, as the GPU's
 /// reduction starts).
 pub fn min_dt(dt_limit: &[f32]) -> f32 {
     dt_limit.iter().copied().fold(f32::MAX, f32::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cpu::fixture::{Fixture, fixture};
+    use crate::physics::Viscosity;
+
+    /// The pass particle by particle over `Grid::rows`, each pair by the `f32` formulas: what
+    /// every lane must give, to the bit.
+    fn one_by_one(pass: &Pass) -> (Vec<[f32; 4]>, Vec<f32>) {
+        let (grid, sides) = (pass.grid, pass.sides);
+        (0..sides.len())
+            .map(|i| {
+                let mut sum = PairSum::default();
+                let mut tau = [0.0f32; 3];
+                grid.rows(grid.coords(&sides[i].x), |range| {
+                    for j in range {
+                        let g = pass.model.add_pair(&sides[i], &sides[j], true, &mut sum);
+                        if let (Some(g), Some((div, stress, _))) = (g, pass.extra.stress) {
+                            div.add_term(&stress[i], &stress[j], &g, &mut tau);
+                        }
+                    }
+                });
+                for (a, t) in sum.acc.iter_mut().zip(tau) {
+                    *a += t;
+                }
+                pass.finish(i, &sum)
+            })
+            .unzip()
+    }
+
+    fn bits(forces: &[[f32; 4]], dt: &[f32]) -> Vec<u32> {
+        let f = forces.iter().flatten();
+        f.chain(dt).map(|v| v.to_bits()).collect()
+    }
+
+    /// Made-up stresses, different in every particle and component.
+    fn stresses(fx: &Fixture, div: &StressDivergence) -> (Vec<StressSide>, Vec<f32>) {
+        (0..fx.pos.len())
+            .map(|i| {
+                let s = i as f32;
+                let t = [[s, 0.5 * s, 0.0], [0.5 * s, -s, 0.0], [0.0; 3]];
+                (div.side(&fx.pos[i], fx.vel[i][3], &t), 1e-3 * s)
+            })
+            .unzip()
+    }
+
+    #[test]
+    fn each_lane_sums_its_particle_as_the_particle_alone_would() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of two threads");
+        for viscosity in [Viscosity::Multiphase { alpha: 0.05 }, Viscosity::Laminar] {
+            let fx = fixture(viscosity);
+            let model = PairModel::new(&fx.params);
+            let sides: Vec<Side> = (0..fx.pos.len())
+                .map(|i| model.side(&fx.pos[i], &fx.vel[i]))
+                .collect();
+            let div = StressDivergence::new(&fx.params);
+            let (stress, mu) = stresses(&fx, &div);
+            let imposed: Vec<bool> = (0..sides.len()).map(|i| i % 7 == 0).collect();
+            let with_stress = matches!(viscosity, Viscosity::Multiphase { .. });
+            let extra = Extra {
+                stress: with_stress.then_some((&div, stress.as_slice(), mu.as_slice())),
+                imposed: &imposed,
+            };
+            let pass = Pass {
+                model: &model,
+                grid: &fx.grid,
+                sides: &sides,
+                extra: &extra,
+            };
+            let (want_f, want_dt) = one_by_one(&pass);
+            let n = sides.len();
+            // Not a vacuous comparison: nearly every particle feels more than gravity.
+            let pushed = want_f.iter().filter(|f| f[1] != -9.81).count();
+            assert!(pushed > n * 9 / 10, "{pushed} of {n}");
+
+            let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
+            force_pass(&pool, &model, &fx.grid, &sides, &extra, &mut f, &mut dt);
+            assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
+            // The baseline copy, without the AVX2 one, and the whole as one block.
+            let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
+            pass.block(0, &mut f, &mut dt);
+            assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
+        }
+    }
 }

@@ -5,7 +5,31 @@
 //! the state alone: runs are bit-identical whatever came before and on any number of threads.
 
 use crate::gpu::params::SimParams;
+use crate::physics::lanes::{LANES, LaneMask};
 use std::ops::Range;
+
+/// Particles of one row of cells that the vectorised passes take together.
+pub struct Group {
+    /// Their sorted indices.
+    pub range: Range<usize>,
+    /// The cell of the first.
+    pub cell: [i32; 3],
+    /// The x of each one's cell, lane by lane.
+    pub cells_x: [i32; LANES],
+}
+
+impl Group {
+    /// Lanes whose own neighbourhood (`reach` cells each way) holds cell x `x` of a row.
+    #[inline(always)]
+    pub fn near(&self, x: i32, reach: i32) -> LaneMask {
+        LaneMask::from_fn(|k| (x - self.cells_x[k]).abs() <= reach)
+    }
+
+    /// The x of the group's last cell.
+    pub fn last_x(&self) -> i32 {
+        self.cells_x[LANES - 1]
+    }
+}
 
 pub struct Grid {
     dims: [i32; 3],
@@ -32,6 +56,7 @@ impl Grid {
 
     /// The cell of a point, as `cell_coords` in grid.wgsl computes it: points outside the
     /// grid are kept in its border cells.
+    #[inline]
     pub fn coords(&self, x: &[f32; 3]) -> [i32; 3] {
         let mut c = [0; 3];
         for k in 0..3 {
@@ -116,6 +141,64 @@ impl Grid {
                 }
             }
         }
+    }
+}
+
+impl Grid {
+    /// The group that starts at sorted particle `first`: the particles after it, up to
+    /// `end` and [`LANES`] in all, that lie in its row of cells (same y and z), `x(k)` being
+    /// where particle k is. A group shares its neighbour rows, so the vectorised passes take
+    /// it at once.
+    #[inline(always)]
+    pub fn group(&self, first: usize, end: usize, x: impl Fn(usize) -> [f32; 3]) -> Group {
+        let cell = self.coords(&x(first));
+        let mut cells_x = [cell[0]; LANES];
+        let mut stop = first + 1;
+        while stop < end.min(first + LANES) {
+            let c = self.coords(&x(stop));
+            if c[1] != cell[1] || c[2] != cell[2] {
+                break;
+            }
+            cells_x[stop - first] = c[0];
+            stop += 1;
+        }
+        // Lanes past the group repeat its last particle, as the lane sides do.
+        let last = cells_x[stop - first - 1];
+        cells_x[stop - first..].fill(last);
+        Group {
+            range: first..stop,
+            cell,
+            cells_x,
+        }
+    }
+
+    /// Calls `visit` with the sorted-index range and the x of each cell within reach of any
+    /// of the cells `c` to `[x_last, c[1], c[2]]` (a group's row), rows in the order of
+    /// [`Grid::rows`] and cells along each row: a particle of the group visits its own
+    /// neighbours in the order `rows` gives them, among cells of the others.
+    #[inline(always)]
+    pub fn row_span(&self, c: [i32; 3], x_last: i32, mut visit: impl FnMut(Range<usize>, i32)) {
+        let r = self.reach;
+        let (z_lo, z_hi) = ((c[2] - r).max(0), (c[2] + r).min(self.dims[2] - 1));
+        let x0 = (c[0] - r).max(0);
+        let x1 = (x_last + r).min(self.dims[0] - 1);
+        for z in z_lo..=z_hi {
+            for y in (c[1] - r).max(0)..=(c[1] + r).min(self.dims[1] - 1) {
+                let base = self.index([0, y, z]);
+                for x in x0..=x1 {
+                    let lo = self.starts[base + x as usize] as usize;
+                    let hi = self.starts[base + x as usize + 1] as usize;
+                    if hi > lo {
+                        visit(lo..hi, x);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Cells each way the kernel support reaches.
+    pub fn reach(&self) -> i32 {
+        self.reach
     }
 }
 

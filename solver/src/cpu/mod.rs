@@ -8,10 +8,13 @@
 //! its holds, and the open flume. An open flume's parked particles sort after every cell and
 //! take no part in the neighbour passes or the integrators.
 
+#[cfg(test)]
+mod fixture;
 mod forces;
 mod grid;
 mod multiphase;
 mod observe;
+mod simd;
 mod step;
 mod store;
 
@@ -24,6 +27,7 @@ use crate::physics;
 use crate::physics::sediment::pass::SedimentModel;
 use crate::physics::sediment::suspension::Region;
 use grid::Grid;
+use std::sync::Arc;
 
 /// The line naming the CPU backend on `threads` threads (0: one per core).
 pub fn describe(threads: usize) -> String {
@@ -67,7 +71,8 @@ const STAGE_FORCES: usize = 2;
 const STAGE_INTEGRATE: usize = 3;
 
 pub struct CpuEngine {
-    pool: rayon::ThreadPool,
+    /// Shared so that a whole run can go to the pool at once (see `Engine::run`).
+    pool: Arc<rayon::ThreadPool>,
     threads: usize,
     params: SimParams,
     model: physics::Params,
@@ -107,7 +112,7 @@ impl CpuEngine {
         let regions = vec![0; particles.len()];
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
-            pool,
+            pool: Arc::new(pool),
             params: *params,
             model: params.physics(shape.dim, n_phases),
             shape,
@@ -165,12 +170,19 @@ impl Engine for CpuEngine {
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {
-        let mut state = init;
-        for _ in 0..steps {
-            if !self.step(&mut state) {
-                break;
+        // The steps run on one of the pool's own threads: each parallel pass inside is then
+        // a fork among the pool's threads, rather than a hand-off from this thread to the
+        // pool and back (two futex round trips, some ten times a step).
+        let pool = Arc::clone(&self.pool);
+        let state = pool.install(|| {
+            let mut state = init;
+            for _ in 0..steps {
+                if !self.step(&mut state) {
+                    break;
+                }
             }
-        }
+            state
+        });
         Ok(state)
     }
 

@@ -13,7 +13,8 @@ use crate::gpu::params::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
-use crate::physics::sediment::pass::{REGION_HELD, StressDivergence, StressSide};
+use crate::physics::sediment::pass::REGION_HELD;
+use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -90,9 +91,12 @@ impl CpuEngine {
         });
         let div = StressDivergence::new(&self.model);
         let stress: Option<(Vec<StressSide>, Vec<f32>)> = rheology.map(|r| {
-            (0..active)
-                .map(|i| (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu))
-                .unzip()
+            self.pool.install(|| {
+                (0..active)
+                    .into_par_iter()
+                    .map(|i| (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu))
+                    .unzip()
+            })
         });
         let extra = Extra {
             stress: stress
@@ -147,26 +151,22 @@ impl CpuEngine {
         let (dt, dt_prev) = (st.dt, st.dt_prev);
         let store = Store::new(&self.params, &self.model);
         let holds = self.holds(&b);
-        let stored: Vec<(Particle, [f32; 4], Event)> = self.pool.install(|| {
-            (0..b.ids.len())
-                .into_par_iter()
-                .map(|i| {
-                    let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-                    let Some(f) = forces.get(i) else {
-                        // Parked: out of the flow.
-                        return ((*x, *v), *v, Event::default());
-                    };
-                    let held = holds[i];
-                    let phase = store.phase(x);
-                    let moved = verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f);
-                    let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
-                    // Held sediment is at rest in both of the leapfrog's sequences.
-                    let prev = if held { [0.0, 0.0, 0.0, v[3]] } else { *v };
-                    (out, prev, event)
-                })
-                .collect()
+        let buffers = std::mem::take(&mut self.a);
+        let next = Self::store_all(&self.pool, st, buffers, |i| {
+            let (x, v) = (&b.positions[i], &b.vel_rho[i]);
+            let Some(f) = forces.get(i) else {
+                // Parked: out of the flow.
+                return ((*x, *v), *v, Event::default());
+            };
+            let held = holds[i];
+            let phase = store.phase(x);
+            let moved = verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f);
+            let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
+            // Held sediment is at rest in both of the leapfrog's sequences.
+            let prev = if held { [0.0, 0.0, 0.0, v[3]] } else { *v };
+            (out, prev, event)
         });
-        self.finish_step(st, b.ids, stored);
+        self.a = State { ids: b.ids, ..next };
     }
 
     fn symplectic(&mut self, st: &mut StepState, grid: &Grid, b: State, forces: &[[f32; 4]]) {
@@ -194,47 +194,43 @@ impl CpuEngine {
         let store = Store::new(&self.params, &self.model);
         // The corrector's rheology pass has set the holds again.
         let holds = self.holds(&b);
-        let stored: Vec<(Particle, [f32; 4], Event)> = self.pool.install(|| {
-            (0..b.ids.len())
-                .into_par_iter()
-                .map(|i| {
-                    let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-                    let Some(f) = forces_half.get(i) else {
-                        return ((*x, *v), b.vel_rho_prev[i], Event::default());
-                    };
-                    let moved = correct(store.phase(x), dt, x, v, v_half[i][3], f);
-                    let (out, event) = store.apply(b.ids[i], x, v, holds[i], dt, moved);
-                    (out, b.vel_rho_prev[i], event)
-                })
-                .collect()
+        let buffers = std::mem::take(&mut self.a);
+        let next = Self::store_all(&self.pool, st, buffers, |i| {
+            let (x, v) = (&b.positions[i], &b.vel_rho[i]);
+            let Some(f) = forces_half.get(i) else {
+                return ((*x, *v), b.vel_rho_prev[i], Event::default());
+            };
+            let moved = correct(store.phase(x), dt, x, v, v_half[i][3], f);
+            let (out, event) = store.apply(b.ids[i], x, v, holds[i], dt, moved);
+            (out, b.vel_rho_prev[i], event)
         });
-        self.finish_step(st, b.ids, stored);
+        self.a = State { ids: b.ids, ..next };
         self.timed(STAGE_INTEGRATE, start);
     }
 
-    /// Takes the stored particles as the new state and their events into the step state.
-    fn finish_step(
-        &mut self,
+    /// Stores each particle (`store_one(i)`: where it goes, its velocity of the step
+    /// before and what storing it did), in parallel, straight into the state that follows
+    /// (the buffers of the state before, whose sorted copy the step read); the events, rare,
+    /// are tallied in sorted order. The state's ids are left to the caller.
+    fn store_all(
+        pool: &rayon::ThreadPool,
         st: &mut StepState,
-        ids: Vec<u32>,
-        stored: Vec<(Particle, [f32; 4], Event)>,
-    ) {
-        let n = stored.len();
-        let mut next = State {
-            positions: Vec::with_capacity(n),
-            vel_rho: Vec::with_capacity(n),
-            ids,
-            vel_rho_prev: Vec::with_capacity(n),
-        };
-        let mut events = Vec::with_capacity(n);
-        for ((x, v), prev, event) in stored {
-            next.positions.push(x);
-            next.vel_rho.push(v);
-            next.vel_rho_prev.push(prev);
-            events.push(event);
-        }
+        mut next: State,
+        store_one: impl Fn(usize) -> (Particle, [f32; 4], Event) + Sync,
+    ) -> State {
+        let events: Vec<Event> = pool.install(|| {
+            let out = next.positions.par_iter_mut().zip(&mut next.vel_rho);
+            out.zip(&mut next.vel_rho_prev)
+                .enumerate()
+                .filter_map(|(i, ((x, v), prev))| {
+                    let ((x_new, v_new), prev_new, event) = store_one(i);
+                    (*x, *v, *prev) = (x_new, v_new, prev_new);
+                    event.happened().then_some(event)
+                })
+                .collect()
+        });
         tally(st, &events);
-        self.a = next;
+        next
     }
 }
 

@@ -18,6 +18,17 @@ pub struct Event {
     pub excluded_sediment: bool,
 }
 
+impl Event {
+    /// Whether storing the particle did anything the counters see.
+    pub fn happened(&self) -> bool {
+        self.flags != 0
+            || self.parked
+            || self.eroded
+            || self.excluded.is_some()
+            || self.excluded_sediment
+    }
+}
+
 pub struct Store<'a> {
     params: &'a SimParams,
     phases: &'a [Phase],

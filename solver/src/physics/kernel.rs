@@ -3,6 +3,7 @@
 //! `W(q) = a_d (1 - q/2)^4 (2q + 1)` for `q = r/h < 2`, with `a_d = 7 / (4 pi h^2)` in 2-D and
 //! `21 / (16 pi h^3)` in 3-D.
 
+use super::lanes::Real;
 use std::f32::consts::PI;
 
 /// Normalisation constant a_d of the Wendland C2 kernel; `dim` is 2 or 3 (anything else is 3-D).
@@ -49,27 +50,25 @@ impl Wendland {
 
     /// W of [`w`].
     #[inline(always)]
-    pub fn w(&self, r: f32) -> f32 {
-        let q = r * self.inv_h;
-        if q < 2.0 {
-            let t = 1.0 - 0.5 * q;
-            let t2 = t * t;
-            self.ad * t2 * t2 * (2.0 * q + 1.0)
-        } else {
-            0.0
-        }
+    pub fn w<L: Real>(&self, r: L) -> L {
+        let s = L::splat;
+        let q = r * s(self.inv_h);
+        let t = s(1.0) - s(0.5) * q;
+        let t2 = t * t;
+        L::select(
+            q.lt(s(2.0)),
+            s(self.ad) * t2 * t2 * (s(2.0) * q + s(1.0)),
+            s(0.0),
+        )
     }
 
     /// F of [`grad_factor`].
     #[inline(always)]
-    pub fn grad_factor(&self, r: f32) -> f32 {
-        let q = r * self.inv_h;
-        if q < 2.0 {
-            let t = 1.0 - 0.5 * q;
-            self.grad_coef * (t * t * t)
-        } else {
-            0.0
-        }
+    pub fn grad_factor<L: Real>(&self, r: L) -> L {
+        let s = L::splat;
+        let q = r * s(self.inv_h);
+        let t = s(1.0) - s(0.5) * q;
+        L::select(q.lt(s(2.0)), s(self.grad_coef) * (t * t * t), s(0.0))
     }
 }
 

@@ -16,6 +16,7 @@ pub mod eos;
 pub mod integrate;
 pub mod interaction;
 pub mod kernel;
+pub mod lanes;
 pub mod probe;
 pub mod sediment;
 pub mod timestep;

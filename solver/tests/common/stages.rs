@@ -371,7 +371,7 @@ fn check_rheology_round(
     particles: &flume_solver::Particles,
     held: &[bool],
 ) -> (Vec<bool>, usize, [usize; 6]) {
-    use flume_solver::physics::sediment::{hold, pass};
+    use flume_solver::physics::sediment::{hold, pass, stress};
     let (pos, vel) = (&particles.positions, &particles.vel_rho);
     let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
     let gpu_regions = sim.regions().expect("regions");
@@ -403,7 +403,7 @@ fn check_rheology_round(
         count[(*r & 255) as usize] += 1;
     }
     let mut cpu = interaction::interact(params, pos, vel);
-    let stress = pass::stress_divergence(params, pos, vel, &rheology);
+    let stress = stress::stress_divergence(params, pos, vel, &rheology);
     for (f, s) in cpu.forces.iter_mut().zip(&stress) {
         for k in 0..3 {
             f[k] += s[k];
@@ -484,7 +484,7 @@ pub fn check_rheology(backend: &Backend, c: Case, seed: u64) {
 /// second step starts from the first one's holds and from its `vel_rho_prev`, so a grain held
 /// for the first step and released in the second is checked too (when there is one).
 pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
-    use flume_solver::physics::sediment::{hold, pass};
+    use flume_solver::physics::sediment::{hold, pass, stress};
     let c = case("tests/cases/sediment_bed_2d.yaml");
     let (mut sim, particles, params) = sediment_in_motion(backend, &c, 23);
     let model = super::reference_sediment(&sim);
@@ -502,7 +502,7 @@ pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
         let mut f = interaction::interact(&params, pos, vel).forces;
         for (f, s) in f
             .iter_mut()
-            .zip(pass::stress_divergence(&params, pos, vel, &r))
+            .zip(stress::stress_divergence(&params, pos, vel, &r))
         {
             for k in 0..3 {
                 f[k] += s[k];

@@ -22,6 +22,7 @@ pub mod hold;
 pub mod pass;
 pub mod rheology;
 pub mod shields;
+pub mod stress;
 pub mod suspension;
 
 /// Material parameters of one sediment and of the water it lies in.

@@ -24,8 +24,9 @@ use super::suspension::{
 };
 use crate::physics::Params;
 use crate::physics::eos::{pressure, tait_b};
-use crate::physics::interaction::{PairGeometry, phase_index, wall_scale};
+use crate::physics::interaction::phase_index;
 use crate::physics::kernel::Wendland;
+use crate::physics::lanes::{LANES, Lanes, Mask, Real};
 
 /// The sediment model of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,18 +70,98 @@ impl ParticleRheology {
     }
 }
 
-/// Sums a particle gathers from its neighbours in the rheology pass.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RheologySums {
+/// Sums a particle (or [`LANES`](crate::physics::lanes::LANES) of them) gathers from its
+/// neighbours in the rheology pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RheologySums<L: Real = f32> {
     /// `grad[a][b] = sum_j V_j (u_j - u_i)_a (grad_i W_ij)_b` (Eq. 13).
-    grad: Tensor3,
-    sediment_volume: f32,
-    mixture_volume: f32,
-    kernel_mass: f32,
+    grad: [[L; 3]; 3],
+    sediment_volume: L,
+    mixture_volume: L,
+    kernel_mass: L,
     /// `sum_water V_j grad_i W_ij`: points from the sediment into the water.
-    normal: [f32; 3],
-    /// Distance to the nearest water particle and its velocity relative to this one.
-    nearest_water: Option<(f32, [f32; 3])>,
+    normal: [L; 3],
+    /// Distance to the nearest water particle (infinite: none in reach) and its velocity
+    /// relative to this one.
+    water_r: L,
+    water_du: [L; 3],
+}
+
+impl<L: Real> Default for RheologySums<L> {
+    fn default() -> Self {
+        let zero = L::splat(0.0);
+        RheologySums {
+            grad: [[zero; 3]; 3],
+            sediment_volume: zero,
+            mixture_volume: zero,
+            kernel_mass: zero,
+            normal: [zero; 3],
+            water_r: L::splat(f32::INFINITY),
+            water_du: [zero; 3],
+        }
+    }
+}
+
+impl RheologySums<Lanes> {
+    /// The sums `sums` side by side; lanes past their number repeat the last one.
+    #[inline(always)]
+    pub fn lanes(sums: &[RheologySums]) -> RheologySums<Lanes> {
+        let mut out = RheologySums::<Lanes>::default();
+        for k in 0..LANES {
+            let s = &sums[k.min(sums.len() - 1)];
+            for a in 0..3 {
+                for b in 0..3 {
+                    out.grad[a][b].0[k] = s.grad[a][b];
+                }
+                out.normal[a].0[k] = s.normal[a];
+                out.water_du[a].0[k] = s.water_du[a];
+            }
+            out.sediment_volume.0[k] = s.sediment_volume;
+            out.mixture_volume.0[k] = s.mixture_volume;
+            out.kernel_mass.0[k] = s.kernel_mass;
+            out.water_r.0[k] = s.water_r;
+        }
+        out
+    }
+
+    /// The sums of lane `k`.
+    #[inline(always)]
+    pub fn lane(&self, k: usize) -> RheologySums {
+        RheologySums {
+            grad: self.grad.map(|row| row.map(|g| g.0[k])),
+            sediment_volume: self.sediment_volume.0[k],
+            mixture_volume: self.mixture_volume.0[k],
+            kernel_mass: self.kernel_mass.0[k],
+            normal: self.normal.map(|n| n.0[k]),
+            water_r: self.water_r.0[k],
+            water_du: self.water_du.map(|u| u.0[k]),
+        }
+    }
+}
+
+/// A particle (or lanes of them) as the rheology pass sees it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RheologySide<L: Real = f32> {
+    pub x: [L; 3],
+    pub v: [L; 3],
+    pub sediment: L::Mask,
+}
+
+impl RheologySide<Lanes> {
+    /// The sides `sides` side by side; lanes past their number repeat the last one.
+    #[inline(always)]
+    pub fn lanes(sides: &[RheologySide]) -> RheologySide<Lanes> {
+        let mut out = RheologySide::<Lanes>::default();
+        for k in 0..LANES {
+            let s = &sides[k.min(sides.len() - 1)];
+            for a in 0..3 {
+                out.x[a].0[k] = s.x[a];
+                out.v[a].0[k] = s.v[a];
+            }
+            out.sediment.0[k] = if s.sediment { u32::MAX } else { 0 };
+        }
+        out
+    }
 }
 
 /// Skeleton pressure p of Eq. 31, Pa, from the sediment particle's pressure `p` (its Tait
@@ -137,10 +218,6 @@ pub fn classify_shields_only(at_surface: bool, tau_b: f32, tau_bcr: f32, c_v: f3
     } else {
         Region::Unyielded
     }
-}
-
-fn sub3(a: &[f32; 4], b: &[f32; 4]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 fn norm3(a: [f32; 3]) -> f32 {
@@ -208,59 +285,77 @@ impl<'a> Rheology<'a> {
         self.params.phases[phase_index(x)].mass / v[3]
     }
 
+    /// Particle `x`, `v` as its pairs see it.
+    pub fn side(&self, x: &[f32; 4], v: &[f32; 4]) -> RheologySide {
+        RheologySide {
+            x: [x[0], x[1], x[2]],
+            v: [v[0], v[1], v[2]],
+            sediment: self.is_sediment(x),
+        }
+    }
+
     /// Adds neighbour j to particle i's sums: nothing beyond the support or for a coincident
     /// pair.
-    #[inline(always)]
     pub fn add_pair(
         &self,
         i: (&[f32; 4], &[f32; 4]),
         j: (&[f32; 4], &[f32; 4]),
         s: &mut RheologySums,
     ) {
-        self.add_pair_of_volume(i, j, self.volume(j.0, j.1), s);
+        let side = self.side(i.0, i.1);
+        self.add_pair_of_volume(&side, j, self.volume(j.0, j.1), true, s);
     }
 
-    /// [`Rheology::add_pair`] with the neighbour's volume `vol_j` ([`Rheology::volume`])
-    /// worked out beforehand, once per particle rather than once per pair.
+    /// [`Rheology::add_pair`] in the lanes `reach` of `i` (`true` for one particle), with
+    /// the neighbour's volume `vol_j` ([`Rheology::volume`]) worked out beforehand, once per
+    /// particle rather than once per pair.
     #[inline(always)]
-    pub fn add_pair_of_volume(
+    pub fn add_pair_of_volume<L: Real>(
         &self,
-        (x_i, v_i): (&[f32; 4], &[f32; 4]),
+        i: &RheologySide<L>,
         (x_j, v_j): (&[f32; 4], &[f32; 4]),
         vol_j: f32,
-        s: &mut RheologySums,
+        reach: L::Mask,
+        s: &mut RheologySums<L>,
     ) {
-        let x_ij = sub3(x_i, x_j);
+        let c = L::splat;
+        let x_ij: [L; 3] = std::array::from_fn(|k| i.x[k] - c(x_j[k]));
         let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
-        if r2 >= self.support2 || r2 < self.coincident2 {
+        let near = reach & !r2.ge(c(self.support2)) & !r2.lt(c(self.coincident2));
+        if !near.any() {
             return;
         }
         let pj = phase_index(x_j);
         let m_j = self.params.phases[pj].mass;
         let r = r2.sqrt();
         let f = self.kernel.grad_factor(r);
-        let du = sub3(v_j, v_i);
+        let du: [L; 3] = std::array::from_fn(|k| c(v_j[k]) - i.v[k]);
         // In 2-D the third row and column are zero: the loops stop at the dimension.
         let dim = self.params.dim as usize;
         for (row, d) in s.grad.iter_mut().zip(du).take(dim) {
             for (g, x) in row.iter_mut().zip(x_ij).take(dim) {
-                *g += vol_j * d * x * f;
+                *g = L::select(near, *g + c(vol_j) * d * x * f, *g);
             }
         }
         let model = self.model;
-        if !self.is_sediment(x_i) || (pj != model.sediment_phase && pj != model.water_phase) {
+        let near = near & i.sediment;
+        if !near.any() || (pj != model.sediment_phase && pj != model.water_phase) {
             return;
         }
-        s.mixture_volume += vol_j;
+        s.mixture_volume = L::select(near, s.mixture_volume + c(vol_j), s.mixture_volume);
         if pj == model.sediment_phase {
-            s.sediment_volume += vol_j;
-            s.kernel_mass += m_j * self.kernel.w(r) * vol_j;
+            let volume = s.sediment_volume;
+            s.sediment_volume = L::select(near, volume + c(vol_j), volume);
+            let mass = s.kernel_mass + c(m_j) * self.kernel.w(r) * c(vol_j);
+            s.kernel_mass = L::select(near, mass, s.kernel_mass);
         } else {
-            for (k, n) in s.normal.iter_mut().enumerate() {
-                *n += vol_j * f * x_ij[k];
+            for (n, x) in s.normal.iter_mut().zip(x_ij) {
+                *n = L::select(near, *n + c(vol_j) * f * x, *n);
             }
-            if s.nearest_water.is_none_or(|(rn, _)| r < rn) {
-                s.nearest_water = Some((r, du));
+            let nearer = near & r.lt(s.water_r);
+            s.water_r = L::select(nearer, r, s.water_r);
+            for (u, d) in s.water_du.iter_mut().zip(du) {
+                *u = L::select(nearer, d, *u);
             }
         }
     }
@@ -325,9 +420,9 @@ impl<'a> Rheology<'a> {
             self.kappa_dp,
             skeleton_pressure(p, mat.rho_s, mat.rho_w),
         );
-        let at_surface = s.nearest_water.is_some() && s.kernel_mass < self.reference_mass;
-        let (tau_b, tau_bcr) = match s.nearest_water {
-            Some((z, u)) if at_surface => {
+        let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
+        let (tau_b, tau_bcr) = match (s.water_r, s.water_du) {
+            (z, u) if at_surface => {
                 let u_star = friction_velocity(norm3(u), z, mat.ks_m(), mat.nu_w).u_star;
                 let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
                 let tau_bcr0 =
@@ -383,108 +478,6 @@ pub fn rheology_pass(
                 pass.add_pair((&pos[i], &vel_rho[i]), (&pos[j], &vel_rho[j]), &mut s);
             }
             pass.finish(&pos[i], &vel_rho[i], &s, held_before[i])
-        })
-        .collect()
-}
-
-/// A particle as the stress divergence sees it: position, phase and `tau / rho^2`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct StressSide {
-    pub x: [f32; 3],
-    pub phase: u32,
-    pub tau_over_rho2: Tensor3,
-}
-
-/// The viscous part of the momentum equation (Eq. 10 with sigma = -p I + tau), pair by pair:
-/// `sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij`, m/s2, for a mobile particle
-/// with the stresses of [`rheology_pass`]; a wall neighbour's mass is scaled by
-/// [`wall_scale`] as in the pressure term (its stress is zero).
-#[derive(Clone, Debug)]
-pub struct StressDivergence<'a> {
-    params: &'a Params,
-    kernel: Wendland,
-    support2: f32,
-    coincident2: f32,
-}
-
-impl<'a> StressDivergence<'a> {
-    pub fn new(params: &'a Params) -> StressDivergence<'a> {
-        let h = params.h;
-        StressDivergence {
-            params,
-            kernel: Wendland::new(h, params.dim),
-            support2: 4.0 * h * h,
-            coincident2: 1e-12 * h * h,
-        }
-    }
-
-    pub fn side(&self, x: &[f32; 4], rho: f32, stress: &Tensor3) -> StressSide {
-        let mut t = *stress;
-        for row in &mut t {
-            for v in row {
-                *v /= rho * rho;
-            }
-        }
-        StressSide {
-            x: [x[0], x[1], x[2]],
-            phase: phase_index(x) as u32,
-            tau_over_rho2: t,
-        }
-    }
-
-    /// Adds neighbour j's term to mobile particle i's acceleration `acc`.
-    #[inline(always)]
-    pub fn add_pair(&self, i: &StressSide, j: &StressSide, acc: &mut [f32; 3]) {
-        let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
-        let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
-        if r2 >= self.support2 || r2 < self.coincident2 {
-            return;
-        }
-        let phases = &self.params.phases;
-        let phase_j = &phases[j.phase as usize];
-        let m_j = if phase_j.mobile {
-            phase_j.mass
-        } else {
-            phase_j.mass * wall_scale(phases[i.phase as usize].rho0, phase_j.rho0)
-        };
-        let f = self.kernel.grad_factor(r2.sqrt());
-        self.add_term(i, j, &PairGeometry { x_ij, f, m_j }, acc);
-    }
-
-    /// The term itself, on a pair whose geometry (`PairModel::add_pair`'s) is known.
-    #[inline(always)]
-    pub fn add_term(&self, i: &StressSide, j: &StressSide, g: &PairGeometry, acc: &mut [f32; 3]) {
-        // In 2-D the third row and column are zero: the loops stop at the dimension.
-        let dim = self.params.dim as usize;
-        let rows = acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2);
-        for ((a, t_i), t_j) in rows.take(dim) {
-            for ((ti, tj), x) in t_i.iter().zip(t_j).zip(g.x_ij).take(dim) {
-                *a += g.m_j * (ti + tj) * x * g.f;
-            }
-        }
-    }
-}
-
-/// [`StressDivergence`] for every particle by brute force (zero for walls).
-pub fn stress_divergence(
-    params: &Params,
-    pos: &[[f32; 4]],
-    vel_rho: &[[f32; 4]],
-    rheology: &[ParticleRheology],
-) -> Vec<[f32; 3]> {
-    let div = StressDivergence::new(params);
-    let sides: Vec<StressSide> = (0..pos.len())
-        .map(|i| div.side(&pos[i], vel_rho[i][3], &rheology[i].stress))
-        .collect();
-    (0..pos.len())
-        .map(|i| {
-            let mut acc = [0.0_f32; 3];
-            if params.phases[phase_index(&pos[i])].mobile {
-                for j in &sides {
-                    div.add_pair(&sides[i], j, &mut acc);
-                }
-            }
-            acc
         })
         .collect()
 }
