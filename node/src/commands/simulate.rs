@@ -1,10 +1,10 @@
 //! `flume-twin simulate`: an offline run of a case, interval by interval.
 
+use crate::adapters::files::inflow::InflowSeries;
+use crate::adapters::files::{bed_plot, outputs::OutputFiles};
+use crate::adapters::progress;
+use crate::adapters::table::{Table, sci, sig};
 use crate::cli::SimulateArgs;
-use crate::inflow::InflowSeries;
-use crate::output::{bed_plot, recorder::Recorder};
-use crate::progress;
-use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation, SolverError};
 use std::path::{Path, PathBuf};
@@ -52,7 +52,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         set_inflow(&mut sim, series, 0.0)?;
     }
 
-    let mut recorder = Recorder::create(&out_dir, &case, snapshot_every)?;
+    let mut recorder = OutputFiles::create(&out_dir, &case, snapshot_every)?;
     let interval_s = case.time.output_interval_s;
     // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
     let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;

@@ -4,8 +4,8 @@
 //! `--steps-seconds` of wall time, on each backend side by side (the native CPU backend and the
 //! wgpu adapter). Nothing here asserts on speed: the figures are for a log.
 
+use crate::adapters::table::{Table, sci, sig};
 use crate::cli::BenchArgs;
-use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::StageTime;
 use flume_solver::{Backend, Case, GpuContext, Simulation};
@@ -55,7 +55,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         );
     }
     if args.frames {
-        return crate::frames_bench::run(&args.flume, args.steps_seconds);
+        return super::bench_frames::run(&args.flume, args.steps_seconds);
     }
     if let Some(n) = args.ladder.iter().find(|n| **n < 100) {
         bail!("--ladder: {n} particles is too few for a dam break; use at least 100");

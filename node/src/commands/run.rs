@@ -5,19 +5,20 @@
 //! out as the bed profile, the eroded mass, the gauge comparison, `/clock` and, once a
 //! second, `/diagnostics`. This module knows topics and times, not SPH.
 
-use crate::bag::Recording;
-use crate::bag::TopicQos;
+use crate::adapters::bag::BagFile;
+use crate::adapters::bag::tap::{Tap, input_channels};
+use crate::adapters::ros::args::RosArgs;
+use crate::adapters::ros::{dds_context, full_topic, live_parameters, outlet, qos, subscription};
+use crate::adapters::topics;
 use crate::cli::{GaugeMsg, RunArgs};
-use crate::clock::NodeClock;
-use crate::inputs::{InputGate, Limits, Readings};
-use crate::observed::{bed_profile, comparison, eroded_mass};
-use crate::pacer::Pacer;
-use crate::ros_args::{ParamValue, RosArgs};
-use crate::samples::{Admitted, Input, Sample, decode, role};
-use crate::solver_thread::{self, Command, Report};
-use crate::tap::{Outlet, Tap, input_channels};
-use crate::topics;
-use crate::visual;
+use crate::twin::clock::NodeClock;
+use crate::twin::gate::{InputGate, Limits, Readings};
+use crate::twin::messages::{bed_profile, comparison, eroded_mass};
+use crate::twin::pacer::Pacer;
+use crate::twin::samples::{Admitted, Input, Sample, decode, role};
+use crate::twin::settings::Settings;
+use crate::twin::solver_thread::{self, Command, Report};
+use crate::twin::visual;
 use anyhow::{Context as _, Result, anyhow, bail};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::{DiagnosticArray, DiagnosticStatus, KeyValue};
@@ -27,266 +28,13 @@ use flume_msgs::sensor_msgs::{PointCloud2, Range};
 use flume_msgs::std_msgs::Header;
 use flume_msgs::std_srvs::{TriggerRequest, TriggerResponse};
 use flume_msgs::visualization_msgs::MarkerArray;
-use flume_msgs::{MsgDef, RosMessage};
 use flume_solver::{Case, Observations};
 use futures::StreamExt;
-use ros2_client::dds::rustdds::DomainParticipantBuilder;
-use ros2_client::qos::{Durability, History, WhenFull};
-use ros2_client::{
-    Context, MessageTypeName, Name, Node, NodeName, NodeOptions, ParameterValue, QosProfile,
-    ServiceMapping, ServiceTypeName, Subscription,
-};
-use serde::Serialize;
-use serde::de::DeserializeOwned;
-use std::net::Ipv4Addr;
+use ros2_client::{Name, NodeName, NodeOptions, ParameterValue, ServiceMapping, ServiceTypeName};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-
-/// A topic's QoS as ros2-client takes it.
-pub fn qos(t: TopicQos) -> QosProfile {
-    let q = QosProfile::publisher_default()
-        .durability(if t.transient_local {
-            Durability::TransientLocal
-        } else {
-            Durability::Volatile
-        })
-        .history(History::KeepLast { depth: t.depth });
-    if t.reliable {
-        q.reliability_reliable(WhenFull::DEFAULT)
-    } else {
-        q.reliability_best_effort()
-    }
-}
-
-pub fn type_name(def: &MsgDef) -> MessageTypeName {
-    MessageTypeName::new(def.package, def.name)
-}
-
-/// A full topic name (`/ns/name`) as ros2-client takes it. Names go to ros2-client absolute:
-/// a relative one under the root namespace would reach DDS as `rt//name`, which no other ROS
-/// node uses.
-pub fn topic_name(full: &str) -> Result<Name> {
-    Name::parse(full).map_err(|e| anyhow!("topic {full:?}: {e}"))
-}
-
-/// A topic's full name after the remaps, as the wire and a recording name it.
-pub fn full_topic(namespace: &str, ros: &RosArgs, name: &str) -> String {
-    let remapped = ros.remap(name);
-    if remapped.starts_with('/') {
-        remapped
-    } else {
-        format!("{}/{remapped}", namespace.trim_end_matches('/'))
-    }
-}
-
-/// A publisher of `M` on `name`, recorded when the node records.
-fn outlet<M: RosMessage + Serialize>(
-    node: &mut Node,
-    recorder: &mut Tap,
-    full: &dyn Fn(&str) -> String,
-    name: &str,
-    topic_qos: TopicQos,
-) -> Result<Outlet<M>> {
-    let q = qos(topic_qos);
-    let topic = node
-        .create_topic(&topic_name(&full(name))?, type_name(M::DEF), &q)
-        .with_context(|| format!("cannot create topic {name}"))?;
-    Ok(Outlet {
-        publisher: node
-            .create_publisher::<M>(&topic, Some(q))
-            .with_context(|| format!("cannot publish {name}"))?,
-        channel: recorder.channel::<M>(&full(name), topic_qos)?,
-    })
-}
-
-fn subscription<M: RosMessage + DeserializeOwned + 'static>(
-    node: &mut Node,
-    full: &dyn Fn(&str) -> String,
-    name: &str,
-    qos: QosProfile,
-) -> Result<Subscription<M>> {
-    let topic = node
-        .create_topic(&topic_name(&full(name))?, type_name(M::DEF), &qos)
-        .with_context(|| format!("cannot create topic {name}"))?;
-    node.create_subscription::<M>(&topic, Some(qos))
-        .with_context(|| format!("cannot subscribe to {name}"))
-}
-
-/// ROS 2 on DDS domain `domain_id`, on the loopback interface only when `loopback`.
-pub fn dds_context(loopback: bool, domain_id: u16) -> Result<Context> {
-    if loopback {
-        let participant = DomainParticipantBuilder::new(domain_id)
-            .with_only_networks([Ipv4Addr::LOCALHOST])
-            .build()
-            .context("cannot start DDS on the loopback interface")?;
-        Context::from_domain_participant(participant)
-    } else {
-        Context::with_options(ros2_client::ContextOptions::new().domain_id(domain_id))
-    }
-    .context("cannot start ROS 2 (DDS)")
-}
-
-/// Settings of a run, from the command line, then parameter files and `-p` (which win).
-#[derive(Debug, Clone)]
-struct Settings {
-    target_rtf: f64,
-    publish_rate_hz: f64,
-    stale_after_s: f64,
-    frame_id: String,
-    /// The gauges' topic names (p1, p2, ...) and the height of each range sensor above the
-    /// flume floor, m (parameters `gauge_mount_height_m.p1`, ...).
-    gauges: Vec<String>,
-    mount_height_m: Vec<f64>,
-    /// The node's time is `/clock` (read at start only).
-    use_sim_time: bool,
-}
-
-impl Settings {
-    /// Settings for gauges `gauges` (topic names), range sensors mounted at `flume_top_m`
-    /// unless a parameter says otherwise.
-    fn new(
-        args: &RunArgs,
-        gauges: &[String],
-        flume_top_m: f64,
-        params: &[(String, ParamValue)],
-    ) -> Result<Settings> {
-        let mut s = Settings {
-            target_rtf: args.target_rtf,
-            publish_rate_hz: args.publish_rate_hz,
-            stale_after_s: args.stale_after_s,
-            frame_id: "flume".into(),
-            gauges: gauges.to_vec(),
-            mount_height_m: vec![flume_top_m; gauges.len()],
-            use_sim_time: false,
-        };
-        for (name, value) in params {
-            let gauge = name.strip_prefix(MOUNT_HEIGHT);
-            let known = match gauge {
-                // A parameter file may serve cases with more gauges than this one.
-                Some(g) => s.gauges.iter().any(|n| n == g),
-                None => PARAMETERS.contains(&name.as_str()),
-            };
-            if !known {
-                log::warn!("parameter {name} is not one of flume_twin's for this case; ignored");
-                continue;
-            }
-            s.apply(name, value)
-                .map_err(|reason| anyhow!("parameter {name}: {reason}"))?;
-        }
-        Ok(s)
-    }
-
-    /// Sets parameter `name`, or says why not.
-    fn apply(&mut self, name: &str, value: &ParamValue) -> Result<(), String> {
-        let number = || {
-            value
-                .as_f64()
-                .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| format!("must be a positive number, got {value:?}"))
-        };
-        match name {
-            "target_real_time_factor" => self.target_rtf = number()?,
-            "publish_rate_hz" => self.publish_rate_hz = number()?,
-            "stale_after_s" => self.stale_after_s = number()?,
-            "frame_id" => match value {
-                ParamValue::String(f) if !f.is_empty() => self.frame_id = f.clone(),
-                other => return Err(format!("must be a non-empty string, got {other:?}")),
-            },
-            "use_sim_time" => match value {
-                ParamValue::Bool(b) => self.use_sim_time = *b,
-                other => return Err(format!("must be true or false, got {other:?}")),
-            },
-            other => match other
-                .strip_prefix(MOUNT_HEIGHT)
-                .and_then(|g| self.gauges.iter().position(|n| n == g))
-            {
-                Some(k) => self.mount_height_m[k] = number()?,
-                None => return Err(format!("{other} is not a parameter of flume_twin")),
-            },
-        }
-        Ok(())
-    }
-
-    /// The values to declare to ROS, as `ros2 param` shows them.
-    fn declared(&self) -> Vec<(String, ParameterValue)> {
-        let mut out: Vec<(String, ParameterValue)> = vec![
-            (
-                "target_real_time_factor",
-                ParameterValue::Double(self.target_rtf),
-            ),
-            (
-                "publish_rate_hz",
-                ParameterValue::Double(self.publish_rate_hz),
-            ),
-            ("stale_after_s", ParameterValue::Double(self.stale_after_s)),
-            ("frame_id", ParameterValue::String(self.frame_id.clone())),
-            ("use_sim_time", ParameterValue::Boolean(self.use_sim_time)),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
-        for (g, h) in self.gauges.iter().zip(&self.mount_height_m) {
-            out.push((format!("{MOUNT_HEIGHT}{g}"), ParameterValue::Double(*h)));
-        }
-        out
-    }
-}
-
-/// The prefix of the range sensors' mount heights: `gauge_mount_height_m.p1`, m.
-pub const MOUNT_HEIGHT: &str = "gauge_mount_height_m.";
-
-/// The node's parameters besides the mount heights (use_sim_time is ROS's own).
-pub const PARAMETERS: [&str; 5] = [
-    "target_real_time_factor",
-    "publish_rate_hz",
-    "stale_after_s",
-    "frame_id",
-    "use_sim_time",
-];
-
-/// A parameter value from ROS as ours; arrays are none of our parameters.
-fn from_ros(value: &ParameterValue) -> Option<ParamValue> {
-    match value {
-        ParameterValue::Boolean(b) => Some(ParamValue::Bool(*b)),
-        ParameterValue::Integer(i) => Some(ParamValue::Integer(*i)),
-        ParameterValue::Double(d) => Some(ParamValue::Double(*d)),
-        ParameterValue::String(t) => Some(ParamValue::String(t.clone())),
-        _ => None,
-    }
-}
-
-/// `ros2 param set` on a running node: the validator refuses with the reason, the action
-/// applies to the settings the loop reads.
-fn live_parameters(options: NodeOptions, live: &Arc<Mutex<Settings>>) -> NodeOptions {
-    let check = Arc::clone(live);
-    let set = Arc::clone(live);
-    let lock = |m: &Arc<Mutex<Settings>>| -> Settings {
-        m.lock().unwrap_or_else(|p| p.into_inner()).clone()
-    };
-    let initial = lock(live);
-    let mut options = options;
-    for (name, value) in initial.declared() {
-        options = options.declare_parameter(&name, value);
-    }
-    options
-        .parameter_validator(Box::new(move |name, value| {
-            let value =
-                from_ros(value).ok_or_else(|| format!("{name}: arrays are not accepted"))?;
-            lock(&check)
-                .apply(name, &value)
-                .map_err(|r| format!("{name}: {r}"))
-        }))
-        .parameter_set_action(Box::new(move |name, value| {
-            let value =
-                from_ros(value).ok_or_else(|| format!("{name}: arrays are not accepted"))?;
-            let mut s = set.lock().unwrap_or_else(|p| p.into_inner());
-            s.apply(name, &value).map_err(|r| format!("{name}: {r}"))?;
-            log::info!("parameter {name} set to {value:?}");
-            Ok(())
-        }))
-}
 
 /// Runs the node until Ctrl-C (or `--until`).
 pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
@@ -660,7 +408,7 @@ async fn serve(
             },
             Some(sample) = fallback_rx.recv() => {
                 recorder.input(&sample);
-                take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, crate::clock::system_s());
+                take(sample.input(), &mut gate, &mut pacer, &mut measured, &gauge_names, &settings.mount_height_m, crate::twin::clock::system_s());
             }
             Some(report) = reports.recv() => {
                 outstanding = outstanding.saturating_sub(1);
@@ -952,7 +700,7 @@ async fn play_when_silent(
     }
     let read = tokio::task::spawn_blocking({
         let path = path.clone();
-        move || Recording::read(&path)
+        move || BagFile::read(&path)
     })
     .await;
     let recording = match read {
@@ -996,7 +744,7 @@ async fn play_when_silent(
         path.display(),
         samples.len()
     );
-    let start = crate::clock::system_s();
+    let start = crate::twin::clock::system_s();
     let started = Instant::now();
     for (_, mut sample) in samples {
         let offset = sample.stamp().as_secs_f64() - first;
@@ -1071,85 +819,5 @@ impl Period {
         );
         *self = Period::new(sim_t);
         out
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use clap::Parser;
-
-    fn run_args(extra: &[&str]) -> RunArgs {
-        let mut argv = vec!["flume-twin", "run", "case.yaml"];
-        argv.extend_from_slice(extra);
-        match crate::cli::Cli::parse_from(argv).command {
-            crate::cli::Command::Run(a) => a,
-            _ => unreachable!("parsed a run"),
-        }
-    }
-
-    #[test]
-    fn the_shipped_parameter_file_sets_the_node_and_bad_values_are_refused() {
-        let file = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../launch_configs/flume_twin.params.yaml"
-        );
-        let ros =
-            RosArgs::parse(&["--params-file", file, "-p", "publish_rate_hz:=4"]).expect("parses");
-        let s = Settings::new(
-            &run_args(&[]),
-            &["p1".to_string()],
-            0.3,
-            &ros.parameters("/flume/flume_twin").expect("reads"),
-        )
-        .expect("valid");
-        assert_eq!(s.target_rtf, 1.0);
-        assert_eq!(s.publish_rate_hz, 4.0, "-p wins over the file");
-        assert_eq!(s.stale_after_s, 2.0);
-        assert_eq!(s.frame_id, "flume");
-        assert_eq!(s.mount_height_m, vec![0.3], "the file's p1");
-        let ros = RosArgs::parse(&["-p", "gauge_mount_height_m.p1:=0.25"]).expect("parses");
-        let s = Settings::new(
-            &run_args(&[]),
-            &["p1".to_string()],
-            0.3,
-            &ros.parameters("/flume_twin").expect("reads"),
-        )
-        .expect("valid");
-        assert_eq!(s.mount_height_m, vec![0.25]);
-        // The file's p2 and p3 are not in this case: ignored, as is a p9 on the command line.
-        let ros = RosArgs::parse(&["-p", "gauge_mount_height_m.p9:=0.25"]).expect("parses");
-        let s = Settings::new(
-            &run_args(&[]),
-            &["p1".to_string()],
-            0.3,
-            &ros.parameters("/flume_twin").expect("reads"),
-        )
-        .expect("ignored");
-        assert_eq!(s.mount_height_m, vec![0.3]);
-        let mut live = s.clone();
-        assert!(
-            live.apply("gauge_mount_height_m.p9", &ParamValue::Double(0.2))
-                .is_err()
-        );
-        assert!(
-            live.apply("gauge_mount_height_m.p1", &ParamValue::Double(-0.2))
-                .is_err()
-        );
-        for (bad, reason) in [
-            ("target_real_time_factor:=-1", "must be a positive number"),
-            ("publish_rate_hz:=fast", "must be a positive number"),
-            ("frame_id:=3", "must be a non-empty string"),
-        ] {
-            let ros = RosArgs::parse(&["-p", bad]).expect("parses");
-            let err = Settings::new(
-                &run_args(&[]),
-                &["p1".to_string()],
-                0.3,
-                &ros.parameters("/flume_twin").expect("reads"),
-            )
-            .expect_err("refused");
-            assert!(err.to_string().contains(reason), "{bad}: {err}");
-        }
     }
 }

@@ -1,9 +1,9 @@
 //! The solver on a thread of its own: GPU work never blocks the async runtime. The node sends
 //! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
 
-use crate::frames::{Frames, in_flume_frame};
-use crate::output::recorder::Recorder;
-use crate::visual::CloudPoint;
+use crate::adapters::files::outputs::OutputFiles;
+use crate::adapters::frames::{Frames, in_flume_frame};
+use crate::twin::visual::CloudPoint;
 use anyhow::{Context, Result};
 use flume_solver::Particles;
 use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation};
@@ -77,12 +77,12 @@ pub fn spawn(
     let handle = std::thread::Builder::new()
         .name("flume-solver".into())
         .spawn(move || {
-            let started = (|| -> Result<(Backend, Simulation, Option<Recorder>)> {
+            let started = (|| -> Result<(Backend, Simulation, Option<OutputFiles>)> {
                 let backend = Backend::choose().context("cannot open a backend")?;
                 let sim = Simulation::new(backend.clone(), &case)
                     .context("cannot set up the simulation")?;
                 let recorder = match &out {
-                    Some(dir) => Some(Recorder::create(dir, &case, None)?),
+                    Some(dir) => Some(OutputFiles::create(dir, &case, None)?),
                     None => None,
                 };
                 Ok((backend, sim, recorder))
@@ -194,7 +194,7 @@ fn sim_adapter(sim: &Simulation) -> String {
 
 fn observe(
     sim: &Simulation,
-    recorder: Option<&mut Recorder>,
+    recorder: Option<&mut OutputFiles>,
     k: u64,
 ) -> Result<Observations, String> {
     match recorder {

@@ -4,19 +4,19 @@
 //! each discharge applied at its own stamp, so the same recording on the same adapter gives
 //! the same bits out. The output recording holds the replayed inputs (as recorded) and the
 //! twin's outputs, stamped on the recording's clock. With `--publish` the sensor topics go on
-//! the wire instead (`play.rs`).
+//! the wire instead (`play`).
 
-use crate::bag::writer::Channel as BagChannel;
-use crate::bag::{BagWriter, Recorded, Recording};
+use crate::adapters::bag::writer::Channel as BagChannel;
+use crate::adapters::bag::{BagFile, BagMessage, BagWriter};
+use crate::adapters::ros::args::RosArgs;
+use crate::adapters::topics;
 use crate::cli::ReplayArgs;
-use crate::inputs::{self, InputGate, Readings};
-use crate::observed::{bed_profile, comparison, eroded_mass};
-use crate::ros_args::RosArgs;
-use crate::run::{MOUNT_HEIGHT, PARAMETERS};
-use crate::samples::{Admitted, Input, decode, role};
-use crate::solver_thread::{self, Command};
-use crate::topics;
-use crate::visual;
+use crate::twin::gate::{InputGate, Limits, Readings};
+use crate::twin::messages::{bed_profile, comparison, eroded_mass};
+use crate::twin::samples::{Admitted, Input, decode, role};
+use crate::twin::settings::mount_heights;
+use crate::twin::solver_thread::{self, Command};
+use crate::twin::visual;
 use anyhow::{Context, Result, anyhow, bail};
 use flume_msgs::RosMessage;
 use flume_msgs::builtin_interfaces::Time;
@@ -86,7 +86,7 @@ impl Outputs {
     }
 
     /// Copies a replayed input as it was recorded.
-    fn input(&mut self, msg: &Recorded) -> Result<()> {
+    fn input(&mut self, msg: &BagMessage) -> Result<()> {
         let channel = match self.inputs.get(&msg.topic) {
             Some(c) => *c,
             None => {
@@ -110,37 +110,8 @@ impl Outputs {
     }
 }
 
-/// The height of each gauge's range sensor above the floor: the live twin's parameters
-/// `gauge_mount_height_m.<gauge>` (the gauge's name in lower case) from `--ros-args -p` or
-/// `--params-file`, else the flume's top. The node's other parameters mean nothing to an
-/// in-process replay and are ignored; a name that is none of the node's is said.
-fn mount_heights(ros: &RosArgs, gauges: &[String], flume_top_m: f64) -> Result<Vec<f64>> {
-    let mut heights = vec![flume_top_m; gauges.len()];
-    for (name, value) in ros.parameters(&ros.node_fqn("flume_twin"))? {
-        let Some(gauge) = name.strip_prefix(MOUNT_HEIGHT) else {
-            if !PARAMETERS.contains(&name.as_str()) {
-                log::warn!("{name} is not a parameter of flume_twin: ignored");
-            }
-            continue;
-        };
-        // A parameter file may serve cases with more gauges than this one.
-        let Some(k) = gauges.iter().position(|g| g.to_lowercase() == gauge) else {
-            log::warn!("{name}: this case has no gauge {gauge}: ignored");
-            continue;
-        };
-        heights[k] = value
-            .as_f64()
-            .filter(|h| h.is_finite() && *h > 0.0)
-            .ok_or_else(|| anyhow!("{name} must be a positive number, got {value:?}"))?;
-    }
-    Ok(heights)
-}
-
-/// Replays `args.recording` through the twin, or with `--publish` on the wire.
+/// Replays `args.recording` through the twin.
 pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
-    if args.publish {
-        return crate::play::run(args, ros_args);
-    }
     let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
     if !ros.remaps.is_empty() {
         log::warn!(
@@ -157,7 +128,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
             config.display()
         );
     }
-    let recording = Recording::read(&args.recording)?;
+    let recording = BagFile::read(&args.recording)?;
     if let Some(damage) = &recording.damage {
         log::warn!("{damage}; replaying what comes before it");
         eprintln!("warning: {damage}; replaying what comes before it");
@@ -170,7 +141,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         .collect();
     let selected = |topic: &str| args.topics.is_empty() || args.topics.iter().any(|t| t == topic);
     // (message, role) in log order; what the twin does not take is said once per topic.
-    let mut feed: Vec<(&Recorded, Option<usize>)> = Vec::new();
+    let mut feed: Vec<(&BagMessage, Option<usize>)> = Vec::new();
     let mut ignored: BTreeMap<&str, (&str, u64)> = BTreeMap::new();
     for m in &recording.messages {
         match role(m, &gauge_names).filter(|_| selected(&m.topic)) {
@@ -189,8 +160,8 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
             gauge_names.join(", ")
         );
     };
-    let start_ns = first_ns + crate::bag::writer::nanos(args.start_s);
-    let limits = inputs::Limits::for_case(&case, args.future_tolerance_s);
+    let start_ns = first_ns + crate::adapters::bag::writer::nanos(args.start_s);
+    let limits = Limits::for_case(&case, args.future_tolerance_s);
     let mut gate = InputGate::new(limits.clone());
     let mut undecodable = 0u64;
     // Samples before the start are passed over, but the discharge in force at the start holds.
@@ -348,58 +319,4 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         }
     );
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn heights(args: &[&str]) -> Result<Vec<f64>> {
-        let gauges = ["P1".to_string(), "P2".to_string()];
-        mount_heights(&RosArgs::parse(args).expect("parses"), &gauges, 0.3)
-    }
-
-    #[test]
-    fn range_gauges_take_the_live_twin_s_mount_heights() {
-        assert_eq!(heights(&[]).expect("defaults"), vec![0.3, 0.3]);
-        assert_eq!(
-            heights(&[
-                "-p",
-                "gauge_mount_height_m.p2:=0.25",
-                "-p",
-                "publish_rate_hz:=4.0"
-            ])
-            .expect("p2 set, the rest ignored"),
-            vec![0.3, 0.25]
-        );
-        let file = std::env::temp_dir().join(format!("mounts-{}.yaml", std::process::id()));
-        std::fs::write(
-            &file,
-            "/flume/flume_twin:\n  ros__parameters:\n    gauge_mount_height_m:\n      p1: 0.22\n",
-        )
-        .expect("writes");
-        let path = file.to_str().expect("utf-8");
-        let h = heights(&["--params-file", path, "-r", "__ns:=/flume"]).expect("the file");
-        assert_eq!(
-            h,
-            vec![0.22, 0.3],
-            "the file's entry for the twin under /flume"
-        );
-        let h = heights(&["--params-file", path]).expect("the file");
-        assert_eq!(
-            h,
-            vec![0.3, 0.3],
-            "an entry for another node's name does not apply"
-        );
-        let _ = std::fs::remove_file(&file);
-        assert_eq!(
-            heights(&["-p", "gauge_mount_height_m.p9:=0.2"]).expect("p9 ignored"),
-            vec![0.3, 0.3]
-        );
-        let err = heights(&["-p", "gauge_mount_height_m.p1:=-0.2"]).expect_err("refused");
-        assert!(
-            err.to_string().contains("must be a positive number"),
-            "{err}"
-        );
-    }
 }
