@@ -11,12 +11,12 @@ use crate::adapters::bag::{BagFile, BagMessage, BagWriter};
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::topics;
 use crate::cli::ReplayArgs;
-use crate::twin::gate::{InputGate, Limits, Readings};
-use crate::twin::messages::{bed_profile, comparison, eroded_mass};
+use crate::twin::gate::{InputGate, Limits};
+use crate::twin::messages::Outputs;
+use crate::twin::readings::{Readings, compared_at};
 use crate::twin::samples::{Admitted, Input, decode, role};
 use crate::twin::settings::mount_heights;
 use crate::twin::solver_thread::{self, Command};
-use crate::twin::visual;
 use anyhow::{Context, Result, anyhow, bail};
 use flume_msgs::RosMessage;
 use flume_msgs::builtin_interfaces::Time;
@@ -29,7 +29,7 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 /// The output recording's channels.
-struct Outputs {
+struct OutputBag {
     bag: BagWriter,
     inputs: BTreeMap<String, BagChannel>,
     clock: BagChannel,
@@ -39,11 +39,11 @@ struct Outputs {
     marker: BagChannel,
 }
 
-impl Outputs {
-    fn create(path: &std::path::Path) -> Result<Outputs> {
+impl OutputBag {
+    fn create(path: &std::path::Path) -> Result<OutputBag> {
         let mut bag = BagWriter::create(path, None)?;
         let abs = |t: &str| format!("/{}", t.trim_start_matches('/'));
-        Ok(Outputs {
+        Ok(OutputBag {
             inputs: BTreeMap::new(),
             clock: bag.channel::<Clock>(&abs(topics::CLOCK), topics::STREAM_QOS)?,
             bed: bag.channel::<BedProfile>(&abs(topics::BED_PROFILE), topics::LATCHED_QOS)?,
@@ -68,21 +68,15 @@ impl Outputs {
             stamp,
             frame_id: "flume".into(),
         };
-        let bed = bed_profile(obs, header.clone());
+        let out = Outputs::of(obs, header, measured, stale);
         self.bag
             .write(self.clock, &Clock { clock: stamp }, ns, ns)?;
-        self.bag.write(
-            self.marker,
-            &visual::bed_lines(&header, &bed.x_m, &bed.zs_m, &bed.zw_m),
-            ns,
-            ns,
-        )?;
-        self.bag.write(self.bed, &bed, ns, ns)?;
-        if let Some(msg) = eroded_mass(obs, header.clone()) {
-            self.bag.write(self.eroded, &msg, ns, ns)?;
+        self.bag.write(self.marker, &out.marker, ns, ns)?;
+        self.bag.write(self.bed, &out.bed, ns, ns)?;
+        if let Some(msg) = &out.eroded {
+            self.bag.write(self.eroded, msg, ns, ns)?;
         }
-        let msg = comparison(obs, measured, stale, header);
-        self.bag.write(self.compare, &msg, ns, ns)
+        self.bag.write(self.compare, &out.comparison, ns, ns)
     }
 
     /// Copies a replayed input as it was recorded.
@@ -216,25 +210,22 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     );
 
     let solver_thread::SolverThread {
-        commands,
+        link:
+            solver_thread::SolverLink {
+                commands,
+                adapter,
+                particles,
+                first,
+            },
         mut reports,
-        adapter,
-        particles,
-        first,
         handle,
     } = solver_thread::spawn(case, args.csv.clone(), None)?;
     println!("adapter: {adapter}\nparticles: {particles}");
-    let mut out = args.out.as_deref().map(Outputs::create).transpose()?;
-    let compare_at = |measured: &mut [Readings], t: f64| {
-        let at: Vec<Option<f64>> = measured.iter_mut().map(|m| m.at(t)).collect();
-        // A gauge is stale when its last sample is older than the output by more than
-        // `--stale-after-s` (a live twin judges by its clock instead).
-        let stale: Vec<bool> = measured
-            .iter()
-            .map(|m| m.newest().is_none_or(|n| t - n > args.stale_after_s))
-            .collect();
-        (at, stale)
-    };
+    let mut out = args.out.as_deref().map(OutputBag::create).transpose()?;
+    // A gauge is stale when its last sample is older than the output by more than
+    // `--stale-after-s` (a live twin judges by its clock instead).
+    let compare_at =
+        |measured: &mut [Readings], t: f64| compared_at(measured, t, Some(t), args.stale_after_s);
     if let Some(out) = out.as_mut() {
         let (at, stale) = compare_at(&mut measured, origin);
         out.observation(

@@ -251,30 +251,6 @@ pub struct GaugeSample {
     pub reading: Reading,
 }
 
-/// A gauge's accepted readings, oldest first, from the one in force at the last output on.
-#[derive(Debug, Clone, Default)]
-pub struct Readings(std::collections::VecDeque<(f64, f64)>);
-
-impl Readings {
-    pub fn push(&mut self, stamp_s: f64, level_m: f64) {
-        self.0.push_back((stamp_s, level_m));
-    }
-
-    /// The newest stamp heard, s.
-    pub fn newest(&self) -> Option<f64> {
-        self.0.back().map(|r| r.0)
-    }
-
-    /// The level in force at `t` (the last reading stamped at or before it), forgetting the
-    /// readings it supersedes: outputs come in time order.
-    pub fn at(&mut self, t: f64) -> Option<f64> {
-        while self.0.len() > 1 && self.0[1].0 <= t {
-            self.0.pop_front();
-        }
-        self.0.front().filter(|r| r.0 <= t).map(|r| r.1)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -364,20 +340,5 @@ mod tests {
             Err(Rejection::LevelOutsideFlume { .. })
         ));
         assert_eq!(g.refused_total(), 3);
-    }
-
-    #[test]
-    fn a_gauge_is_compared_with_its_reading_at_the_output_time() {
-        let mut r = Readings::default();
-        assert_eq!(r.at(1.0), None, "no reading yet");
-        r.push(1.0, 0.07);
-        r.push(1.2, 0.08);
-        r.push(1.4, 0.09);
-        assert_eq!(r.at(0.5), None, "before the first reading");
-        assert_eq!(r.at(1.1), Some(0.07));
-        assert_eq!(r.at(1.3), Some(0.08));
-        assert_eq!(r.newest(), Some(1.4));
-        assert_eq!(r.at(2.0), Some(0.09));
-        assert_eq!(r.0.len(), 1, "superseded readings are forgotten");
     }
 }

@@ -53,12 +53,18 @@ pub struct FrameSettings {
 
 /// The solver thread's end of the channels, and what it says when it starts.
 pub struct SolverThread {
-    pub commands: mpsc::Sender<Command>,
+    pub link: SolverLink,
     pub reports: async_mpsc::UnboundedReceiver<Result<Report, String>>,
+    pub handle: JoinHandle<()>,
+}
+
+/// What the twin keeps of the solver: where its commands go, and what it said at the start.
+pub struct SolverLink {
+    pub commands: mpsc::Sender<Command>,
     pub adapter: String,
     pub particles: usize,
+    /// The observations at t = 0.
     pub first: Observations,
-    pub handle: JoinHandle<()>,
 }
 
 /// Starts the solver for `case` on its own thread; returns once the GPU is open and the case
@@ -179,11 +185,13 @@ pub fn spawn(
         .context("the solver thread stopped while starting")?
         .map_err(|e| anyhow::anyhow!(e))?;
     Ok(SolverThread {
-        commands: cmd_tx,
+        link: SolverLink {
+            commands: cmd_tx,
+            adapter,
+            particles,
+            first,
+        },
         reports: rep_rx,
-        adapter,
-        particles,
-        first,
         handle,
     })
 }
