@@ -264,27 +264,13 @@ impl Twin {
     /// A solver report; what goes out, or None while simulated time has not started (there
     /// is no time to stamp outputs with).
     pub fn report(&mut self, report: Report) -> Option<Published> {
-        self.outstanding = self.outstanding.saturating_sub(1);
-        self.sim_t = report.obs.time_s;
-        if report.reset {
-            if !std::mem::take(&mut self.reset_by_clock) {
-                self.renew_inputs();
-            }
-            println!("reset to the case's initial state");
-        }
-        self.counters.solver_refused += report.refused_inflows;
-        self.counters.frames_sent = report.frames_sent;
-        self.counters.frames_skipped = report.frames_skipped;
-        self.period.add(&report);
+        self.take(&report);
         let Some(origin) = self.pacer.origin().or(self.clock.now()) else {
             self.last_obs = report.obs;
             return None;
         };
-        let stamp = Time::from_secs_f64(origin + self.sim_t).unwrap_or_default();
-        let header = Header {
-            stamp,
-            frame_id: self.settings.frame_id.clone(),
-        };
+        let t = origin + self.sim_t;
+        let header = self.header(t);
         let cloud = report.cloud.as_ref().map(|points| {
             visual::point_cloud(header.clone(), points, self.options.cloud_max_points)
         });
@@ -297,25 +283,95 @@ impl Twin {
         let outputs = if due || last {
             self.last_publish = Some(Instant::now());
             self.counters.published_outputs += 1;
-            // Each gauge against its reading at the output's own time.
-            let (at, stale) = compared_at(
-                &mut self.readings,
-                origin + self.sim_t,
-                self.clock.now(),
-                self.settings.stale_after_s,
-            );
-            Some(Outputs::of(&report.obs, header, &at, &stale))
+            let now = self.clock.now();
+            Some(self.outputs(&report.obs, header.clone(), t, now))
         } else {
             self.counters.decimated_outputs += 1;
             None
         };
         self.last_obs = report.obs;
         Some(Published {
-            clock: Clock { clock: stamp },
+            clock: Clock {
+                clock: header.stamp,
+            },
             cloud,
             outputs,
             last,
         })
+    }
+
+    /// What every report changes: the time reached, the inputs after a reset, the counters.
+    fn take(&mut self, report: &Report) {
+        self.outstanding = self.outstanding.saturating_sub(1);
+        self.sim_t = report.obs.time_s;
+        if report.reset {
+            if !std::mem::take(&mut self.reset_by_clock) {
+                self.renew_inputs();
+            }
+            println!("reset to the case's initial state");
+        }
+        self.counters.solver_refused += report.refused_inflows;
+        self.counters.frames_sent = report.frames_sent;
+        self.counters.frames_skipped = report.frames_skipped;
+        self.period.add(report);
+    }
+
+    fn header(&self, t: f64) -> Header {
+        Header {
+            stamp: Time::from_secs_f64(t).unwrap_or_default(),
+            frame_id: self.settings.frame_id.clone(),
+        }
+    }
+
+    /// The outputs of `obs` at time `t` on the node's clock, each gauge against its reading
+    /// at `t` and judged stale at `now`.
+    fn outputs(&mut self, obs: &Observations, header: Header, t: f64, now: Option<f64>) -> Outputs {
+        let after_s = self.settings.stale_after_s;
+        let (at, stale) = compared_at(&mut self.readings, t, now, after_s);
+        Outputs::of(obs, header, &at, &stale)
+    }
+
+    /// Lock-step (a replay): simulated time 0 is `origin` on the recording's clock.
+    pub fn start_at(&mut self, origin: f64) {
+        self.pacer.start_at(origin);
+    }
+
+    /// Lock-step: the discharge in force when the replay starts, from t = 0.
+    pub fn hold_inflow(&mut self, q: f64) {
+        self.pacer.hold(q);
+    }
+
+    /// Lock-step: the solver runs to `to_s` whatever the clock says, with the discharges
+    /// stamped on the way.
+    pub fn advance_to(&mut self, to_s: f64) -> Result<()> {
+        let chunk = self.pacer.chunk_to(self.sim_t, to_s);
+        self.send(Command::Advance {
+            to_s,
+            inflow: chunk.inflow,
+            cloud: false,
+        })
+    }
+
+    /// Lock-step: the outputs of the observations at hand (the case's initial state, before
+    /// any report) at `t` on the recording's clock.
+    pub fn outputs_now(&mut self, t: f64) -> Outputs {
+        let obs = self.last_obs.clone();
+        self.outputs(&obs, self.header(t), t, Some(t))
+    }
+
+    /// Lock-step: a solver report and all its outputs (none decimated) at `t` on the
+    /// recording's clock, a gauge stale when its last sample is older than `t` by more than
+    /// the settings allow.
+    pub fn report_at(&mut self, report: Report, t: f64) -> Outputs {
+        self.take(&report);
+        let out = self.outputs(&report.obs, self.header(t), t, Some(t));
+        self.last_obs = report.obs;
+        out
+    }
+
+    /// The samples the gate refused, by reason.
+    pub fn refused(&self) -> &std::collections::BTreeMap<&'static str, u64> {
+        self.gate.refused()
     }
 
     /// A service call: whether it was done, and what to answer.

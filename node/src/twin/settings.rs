@@ -55,6 +55,20 @@ impl Settings {
         Ok(s)
     }
 
+    /// The settings of an in-process replay: the gauges' mount heights and when a gauge is
+    /// stale; the pace, publish rate and clock are a live node's and mean nothing to it.
+    pub fn for_replay(gauges: &[String], mount_height_m: Vec<f64>, stale_after_s: f64) -> Settings {
+        Settings {
+            target_rtf: 1.0,
+            publish_rate_hz: f64::INFINITY,
+            stale_after_s,
+            frame_id: "flume".into(),
+            gauges: gauges.to_vec(),
+            mount_height_m,
+            use_sim_time: false,
+        }
+    }
+
     /// Sets parameter `name`, or says why not.
     pub fn apply(&mut self, name: &str, value: &ParamValue) -> Result<(), String> {
         let number = || {
