@@ -80,7 +80,7 @@ impl fmt::Display for Rejection {
 /// The checks: limits from the case and the node's settings.
 #[derive(Debug, Clone)]
 pub struct Limits {
-    /// The largest discharge the twin takes, m3/s (the inlet's Mach bound).
+    /// The largest discharge the twin takes, m3/s: the solver's limit for the inlet.
     pub max_discharge_m3_per_s: f64,
     /// Flume height, m: a level outside 0..height is a sensor fault.
     pub flume_height_m: f64,
@@ -93,9 +93,8 @@ impl Limits {
     pub fn for_case(case: &flume_solver::Case, future_tolerance_s: f64) -> Limits {
         let vertical = case.dim() - 1;
         Limits {
-            max_discharge_m3_per_s: case.open_flume.as_ref().map_or(f64::INFINITY, |f| {
-                flume_solver::max_inflow_m3_per_s(f, flume_solver::derive(case).c0)
-            }),
+            max_discharge_m3_per_s: flume_solver::inflow_limit_m3_per_s(case)
+                .unwrap_or(f64::INFINITY),
             flume_height_m: case.domain.max_m[vertical] - case.domain.min_m[vertical],
             future_tolerance_s,
         }

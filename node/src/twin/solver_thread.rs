@@ -6,7 +6,7 @@ use crate::adapters::frames::{Frames, in_flume_frame};
 use crate::twin::visual::CloudPoint;
 use anyhow::{Context, Result};
 use flume_solver::Particles;
-use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation};
+use flume_solver::{Backend, Case, InflowSchedule, Observations, Simulation};
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::thread::JoinHandle;
@@ -222,23 +222,22 @@ fn run_chunk(
 ) -> Result<(f64, u64, u64), String> {
     let started = Instant::now();
     let steps0 = sim.steps();
-    let mut refused = 0;
-    for &(t, q) in inflow {
-        if t > sim.time_s() {
-            sim.advance_to(t).map_err(|e| format!("{e}"))?;
-        }
-        if let Err(e) = sim.set_boundary_conditions(BoundaryConditions { inflow_m3_per_s: q }) {
-            refused += 1;
-            log::warn!("discharge {q} m3/s at t = {t:.3} s refused by the solver: {e}");
-        }
-    }
-    if to_s > sim.time_s() {
-        sim.advance_to(to_s).map_err(|e| format!("{e}"))?;
+    let schedule = InflowSchedule::new(inflow.to_vec());
+    let refused = sim
+        .advance_through(to_s, &schedule)
+        .map_err(|e| format!("{e}"))?;
+    for r in &refused {
+        log::warn!(
+            "discharge {} m3/s at t = {:.3} s refused by the solver: {}",
+            r.inflow_m3_per_s,
+            r.time_s,
+            r.error
+        );
     }
     Ok((
         started.elapsed().as_secs_f64(),
         sim.steps() - steps0,
-        refused,
+        refused.len() as u64,
     ))
 }
 
