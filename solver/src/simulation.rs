@@ -611,6 +611,12 @@ impl Simulation {
         Ok(refused)
     }
 
+    /// The acoustic CFL bound on the time step, CFL h / c0, s: no step is longer, so a run
+    /// to a few times this takes at least that many steps.
+    pub fn acoustic_dt_bound_s(&self) -> f64 {
+        self.case.numerics.cfl * self.derived.h / self.derived.c0
+    }
+
     /// The open flume's host state (discharge, eroded and parked counts); None for a tank.
     pub fn flume(&self) -> Option<&FlumeState> {
         self.flume.as_ref()

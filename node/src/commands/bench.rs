@@ -285,9 +285,8 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measure
     let name = &case.name;
     let mut sim =
         Simulation::new(backend.clone(), case).with_context(|| format!("cannot set up {name}"))?;
-    let derived = sim.derived();
-    // The acoustic CFL limit: the real step is never larger, so the warm-up is at least 4 steps.
-    let dt_guess = case.numerics.cfl * derived.h / derived.c0;
+    // The real step is never larger, so the warm-up is at least 4 steps.
+    let dt_guess = sim.acoustic_dt_bound_s();
     sim.advance_to(4.0 * dt_guess)
         .with_context(|| format!("{name}: warm-up failed"))?;
 
