@@ -17,7 +17,7 @@ use crate::twin::messages::Outputs;
 use crate::twin::samples::{Input, decode, role};
 use crate::twin::settings::{Settings, mount_heights};
 use crate::twin::solver_thread::{self, Report};
-use crate::twin::{Options, Twin};
+use crate::twin::{Options, Twin, gauge_names};
 use anyhow::{Context, Result, anyhow, bail};
 use flume_msgs::RosMessage;
 use flume_msgs::builtin_interfaces::Time;
@@ -117,12 +117,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         log::warn!("{damage}; replaying what comes before it");
         eprintln!("warning: {damage}; replaying what comes before it");
     }
-    let gauge_names: Vec<String> = case
-        .observations
-        .gauges
-        .iter()
-        .map(|g| g.name.clone())
-        .collect();
+    let gauge_names = gauge_names(&case);
     let feed = Feed::read(args, &recording, &gauge_names)?;
     let limits = Limits::for_case(&case, args.future_tolerance_s);
     let mount_height_m = mount_heights(&ros, &gauge_names, limits.flume_height_m)?;

@@ -15,7 +15,7 @@ use crate::twin::gate::Limits;
 use crate::twin::samples::{Sample, decode, role};
 use crate::twin::settings::Settings;
 use crate::twin::solver_thread::{self, FrameSettings, Report};
-use crate::twin::{Options, Published, Service, Twin};
+use crate::twin::{Options, Published, Service, Twin, gauge_names};
 use anyhow::{Context as _, Result, anyhow, bail};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::DiagnosticArray;
@@ -48,20 +48,13 @@ pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
     };
     let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
     let fqn = ros.node_fqn("flume_twin");
-    let vertical = case.dim() - 1;
-    let gauges: Vec<String> = case
-        .observations
-        .gauges
+    let gauges: Vec<String> = gauge_names(&case)
         .iter()
-        .map(|g| g.name.to_lowercase())
+        .map(|g| g.to_lowercase())
         .collect();
-    let settings = Settings::new(
-        args,
-        &gauges,
-        case.domain.max_m[vertical] - case.domain.min_m[vertical],
-        &ros.parameters(&fqn)?,
-    )?;
     let limits = Limits::for_case(&case, args.future_tolerance_s);
+    // Range sensors are mounted at the flume's top unless a parameter says otherwise.
+    let settings = Settings::new(args, &gauges, limits.flume_height_m, &ros.parameters(&fqn)?)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
@@ -79,12 +72,7 @@ async fn serve(
 ) -> Result<()> {
     let namespace = ros.namespace.clone().unwrap_or_else(|| "/".into());
     let node_name = ros.node_name.clone().unwrap_or_else(|| "flume_twin".into());
-    let gauge_names: Vec<String> = case
-        .observations
-        .gauges
-        .iter()
-        .map(|g| g.name.clone())
-        .collect();
+    let gauge_names = gauge_names(&case);
     let frames = (!args.no_frames).then(|| FrameSettings {
         service: args.frames_service.clone(),
         rate_hz: args.frames_rate_hz,

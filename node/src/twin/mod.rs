@@ -31,6 +31,15 @@ use solver_thread::{Command, Report, SolverLink};
 use status::{Counters, Period};
 use std::time::Instant;
 
+/// The case's gauges by name, in the case's order: the twin's sensors besides the inflow.
+pub fn gauge_names(case: &flume_solver::Case) -> Vec<String> {
+    case.observations
+        .gauges
+        .iter()
+        .map(|g| g.name.clone())
+        .collect()
+}
+
 /// What a live twin keeps for the whole run (the settings that may change live are apart).
 #[derive(Debug, Clone)]
 pub struct Options {
