@@ -6,7 +6,7 @@ Usage:
   python3 scripts/rerun_visualiser.py [--service flume_twin/particles]
                                       [--save FILE.rrd | --connect URL | --spawn] [--frames N]
 Without --save/--connect it spawns a rerun viewer. Needs `pip install rerun-sdk iceoryx2`.
-The frame layout is node/src/frames.rs's (version 1), 32 bytes a particle.
+The frame layout is node/src/adapters/frames.rs's (version 1), 32 bytes a particle.
 """
 
 import argparse
@@ -33,7 +33,7 @@ assert PARTICLE.itemsize == 32
 
 
 class Particle(ctypes.Structure):
-    """The slice's element type (node/src/frames.rs); read in bulk through PARTICLE."""
+    """The slice's element type (node/src/adapters/frames.rs); read in bulk through PARTICLE."""
 
     _fields_ = [
         ("position", ctypes.c_float * 3),

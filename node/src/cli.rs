@@ -101,7 +101,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "S", default_value_t = 3.0, value_parser = positive)]
     pub silent_wait_s: f64,
     /// The iceoryx2 service on which every particle goes to visualisers (shared memory).
-    #[arg(long, value_name = "NAME", default_value = crate::frames::SERVICE)]
+    #[arg(long, value_name = "NAME", default_value = crate::adapters::frames::SERVICE)]
     pub frames_service: String,
     /// Most particle frames per wall second.
     #[arg(long, value_name = "HZ", default_value_t = 10.0, value_parser = positive)]

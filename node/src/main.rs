@@ -1,33 +1,13 @@
 //! flume-twin: the command-line front end of the flume digital twin.
 //!
 //! The node moves data between the world and the solver and knows nothing about SPH; every
-//! subcommand lives in its own module and `main` only dispatches.
+//! subcommand lives in `commands/`, the twin's rules in `twin/`, the transports and files in
+//! `adapters/`; `main` only dispatches.
 
-mod bag;
-mod bench;
+mod adapters;
 mod cli;
-mod clock;
-mod frames;
-mod frames_bench;
-mod inflow;
-mod inputs;
-mod observed;
-mod output;
-mod pacer;
-mod play;
-mod progress;
-mod replay;
-mod ros_args;
-mod run;
-mod samples;
-mod session;
-mod simulate;
-mod solver_thread;
-mod sweep;
-mod table;
-mod tap;
-mod topics;
-mod visual;
+mod commands;
+mod twin;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -47,12 +27,14 @@ fn main() -> ExitCode {
     )
     .init();
     let result = match cli.command {
-        cli::Command::Simulate(args) => simulate::run(&args),
-        cli::Command::Bench(args) => bench::run(&args),
-        cli::Command::Run(args) => run::run(&args, &ros_args),
-        cli::Command::Replay(args) => replay::run(&args, &ros_args),
-        cli::Command::MakeSession(args) => session::run(&args),
-        cli::Command::Sweep(args) => sweep::run(&args),
+        cli::Command::Simulate(args) => commands::simulate::run(&args),
+        cli::Command::Bench(args) => commands::bench::run(&args),
+        cli::Command::Run(args) => commands::run::run(&args, &ros_args),
+        // `replay --publish` plays the recording on the wire instead of through the twin.
+        cli::Command::Replay(args) if args.publish => commands::play::run(&args, &ros_args),
+        cli::Command::Replay(args) => commands::replay::run(&args, &ros_args),
+        cli::Command::MakeSession(args) => commands::make_session::run(&args),
+        cli::Command::Sweep(args) => commands::sweep::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -95,6 +95,14 @@ pub fn max_inflow_m3_per_s(f: &OpenFlume, c0: f64) -> f64 {
     MAX_INLET_MACH * c0 * f.inlet.height_m * f.width_m
 }
 
+/// The largest discharge `case`'s inlet carries, m3/s, as `Simulation::set_boundary_conditions`
+/// judges it; None for a case without an open flume. A twin asks this instead of knowing the
+/// inlet's Mach bound and the sound speed.
+pub fn inflow_limit_m3_per_s(case: &Case) -> Option<f64> {
+    let f = case.open_flume.as_ref()?;
+    Some(max_inflow_m3_per_s(f, derive(case).c0))
+}
+
 /// Refuses a case whose own discharge (`open_flume.inflow_m3_per_s`) the inlet cannot carry:
 /// it would blow up in its first microseconds whatever the time step. Needs no GPU.
 pub fn check_inflow(case: &Case) -> Result<(), SolverError> {

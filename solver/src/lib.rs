@@ -13,7 +13,7 @@
 
 pub use backend::{Backend, CPU_BACKEND};
 pub use config::{Case, ConfigError};
-pub use derived::{Derived, check_inflow, derive, max_inflow_m3_per_s};
+pub use derived::{Derived, check_inflow, derive, inflow_limit_m3_per_s};
 pub use engine::StageTime;
 pub use error::SolverError;
 pub use flume::BoundaryConditions;
@@ -26,7 +26,7 @@ pub use observe::{
 };
 pub use particles::{ParticleRegion, Particles};
 pub use physics::sediment::suspension::Region;
-pub use simulation::Simulation;
+pub use simulation::{InflowSchedule, RefusedInflow, Simulation};
 
 /// The case file's types: `Case` and its sections.
 pub mod config;

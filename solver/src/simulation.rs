@@ -29,6 +29,31 @@ pub const CFL_RESTORE_AFTER_CHUNKS: u32 = 50;
 /// this are accepted so that an operator (or a test) can see the recovery bring it back down.
 pub const MAX_CFL: f64 = 5.0;
 
+/// Discharges to apply on the way to a time: `(time s, discharge m3/s)` in time order, each
+/// in force from its own time on (one stamped before the simulation's time applies at once).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct InflowSchedule {
+    changes: Vec<(f64, f64)>,
+}
+
+impl InflowSchedule {
+    pub fn new(changes: Vec<(f64, f64)>) -> InflowSchedule {
+        InflowSchedule { changes }
+    }
+
+    pub fn changes(&self) -> &[(f64, f64)] {
+        &self.changes
+    }
+}
+
+/// A discharge of a schedule that the inlet refused; the one before it stayed in force.
+#[derive(Debug)]
+pub struct RefusedInflow {
+    pub time_s: f64,
+    pub inflow_m3_per_s: f64,
+    pub error: SolverError,
+}
+
 /// Largest number of steps recorded into one submission.
 const MAX_STEPS_PER_SUBMIT: u32 = 400;
 
@@ -555,6 +580,41 @@ impl Simulation {
         self.params.flume.inlet_u = u as f32;
         self.engine.write_params(&self.params);
         Ok(())
+    }
+
+    /// Advances to `target_s`, stopping at each change of `schedule` on the way to apply it at
+    /// its own time. A discharge `set_boundary_conditions` refuses leaves the one before in
+    /// force and comes back in the list, so that a twin fed by sensors runs on; a failure of
+    /// the run itself is the error.
+    pub fn advance_through(
+        &mut self,
+        target_s: f64,
+        schedule: &InflowSchedule,
+    ) -> Result<Vec<RefusedInflow>, SolverError> {
+        let mut refused = Vec::new();
+        for &(t, q) in schedule.changes() {
+            if t > self.time_s {
+                self.advance_to(t)?;
+            }
+            let bc = BoundaryConditions { inflow_m3_per_s: q };
+            if let Err(error) = self.set_boundary_conditions(bc) {
+                refused.push(RefusedInflow {
+                    time_s: t,
+                    inflow_m3_per_s: q,
+                    error,
+                });
+            }
+        }
+        if target_s > self.time_s {
+            self.advance_to(target_s)?;
+        }
+        Ok(refused)
+    }
+
+    /// The acoustic CFL bound on the time step, CFL h / c0, s: no step is longer, so a run
+    /// to a few times this takes at least that many steps.
+    pub fn acoustic_dt_bound_s(&self) -> f64 {
+        self.case.numerics.cfl * self.derived.h / self.derived.c0
     }
 
     /// The open flume's host state (discharge, eroded and parked counts); None for a tank.

@@ -20,7 +20,7 @@ import iceoryx2 as iox2
 
 
 class Particle(ctypes.Structure):
-    """flume_twin::Particle (node/src/frames.rs), layout version 1."""
+    """flume_twin::Particle (node/src/adapters/frames.rs), layout version 1."""
 
     _fields_ = [
         ("position", ctypes.c_float * 3),

@@ -4,8 +4,8 @@
 //! `--steps-seconds` of wall time, on each backend side by side (the native CPU backend and the
 //! wgpu adapter). Nothing here asserts on speed: the figures are for a log.
 
+use crate::adapters::table::{Table, sci, sig};
 use crate::cli::BenchArgs;
-use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::StageTime;
 use flume_solver::{Backend, Case, GpuContext, Simulation};
@@ -55,7 +55,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         );
     }
     if args.frames {
-        return crate::frames_bench::run(&args.flume, args.steps_seconds);
+        return super::bench_frames::run(&args.flume, args.steps_seconds);
     }
     if let Some(n) = args.ladder.iter().find(|n| **n < 100) {
         bail!("--ladder: {n} particles is too few for a dam break; use at least 100");
@@ -285,9 +285,8 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measure
     let name = &case.name;
     let mut sim =
         Simulation::new(backend.clone(), case).with_context(|| format!("cannot set up {name}"))?;
-    let derived = sim.derived();
-    // The acoustic CFL limit: the real step is never larger, so the warm-up is at least 4 steps.
-    let dt_guess = case.numerics.cfl * derived.h / derived.c0;
+    // The real step is never larger, so the warm-up is at least 4 steps.
+    let dt_guess = sim.acoustic_dt_bound_s();
     sim.advance_to(4.0 * dt_guess)
         .with_context(|| format!("{name}: warm-up failed"))?;
 

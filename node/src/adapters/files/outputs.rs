@@ -1,7 +1,7 @@
 //! The files a run writes as it goes (`simulate`, and `run --out`): gauges.csv, profile.csv,
 //! bed_profile.csv, eroded_mass.csv and particle snapshots.
 
-use crate::output::{
+use crate::adapters::files::{
     csv::{BedProfileCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
     vtk,
 };
@@ -26,7 +26,7 @@ fn create_csv<T>(
 
 /// The files of a run: gauges.csv gets a row per output interval, and every
 /// `snapshot_every`-th interval k a snapshot `particles_kkkk.vtk`.
-pub struct Recorder {
+pub struct OutputFiles {
     dir: PathBuf,
     csv_path: PathBuf,
     csv: GaugeCsv<BufWriter<File>>,
@@ -39,13 +39,13 @@ pub struct Recorder {
     snapshot_every: Option<u64>,
 }
 
-impl Recorder {
+impl OutputFiles {
     /// Whether the run writes bed_profile.csv (a sediment and a profile).
     pub fn has_bed_profile(&self) -> bool {
         self.bed_profile.is_some()
     }
 
-    pub fn create(dir: &Path, case: &Case, snapshot_every: Option<u64>) -> Result<Recorder> {
+    pub fn create(dir: &Path, case: &Case, snapshot_every: Option<u64>) -> Result<OutputFiles> {
         fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
         let csv_path = dir.join("gauges.csv");
@@ -73,7 +73,7 @@ impl Recorder {
             Some(_) => Some(create_csv(dir, "eroded_mass.csv", ErodedMassCsv::new)?),
             None => None,
         };
-        Ok(Recorder {
+        Ok(OutputFiles {
             dir: dir.to_path_buf(),
             csv_path,
             csv,

@@ -3,7 +3,7 @@
 //! 3, 5, 7, 10 of the paper's Figure 10 are not).
 
 use super::bed_plot::font_registered;
-use crate::table::sig;
+use crate::adapters::table::sig;
 use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -6,8 +6,8 @@
 //! reader is a thread of this process: the frames still go through the shared memory
 //! iceoryx2 maps for another process, and the figure is not a Python reader's.
 
-use crate::frames::{FrameHeader, Frames, Particle};
-use crate::table::{Table, sig};
+use crate::adapters::frames::{FrameHeader, Frames, Particle};
+use crate::adapters::table::{Table, sig};
 use anyhow::{Context, Result, anyhow};
 use flume_solver::{Case, GpuContext, Simulation};
 use iceoryx2::prelude::*;

@@ -4,9 +4,9 @@
 //! SIGINT and SIGTERM finish the file. A recording that cannot be written is stopped with an
 //! error line; the twin runs on.
 
-use crate::bag::writer::{Channel, nanos};
-use crate::bag::{BagWriter, TopicQos};
-use crate::samples::Sample;
+use crate::adapters::bag::writer::{Channel, nanos};
+use crate::adapters::bag::{BagWriter, TopicQos};
+use crate::twin::samples::Sample;
 use anyhow::Result;
 use flume_msgs::RosMessage;
 use flume_msgs::flume_msgs::{Discharge, WaterLevel};
@@ -52,7 +52,7 @@ impl Tap {
     }
 
     pub fn input(&mut self, sample: &Sample) {
-        let now = nanos(crate::clock::system_s());
+        let now = nanos(crate::twin::clock::system_s());
         let sent = sample.stamp().as_nanos().unwrap_or(now);
         let (k, result) = match sample {
             Sample::Inflow(m) => (0, self.write_to(0, m, now, sent)),
@@ -75,7 +75,7 @@ impl Tap {
         let (Some(bag), Some(ch)) = (self.bag.as_mut(), channel) else {
             return;
         };
-        let now = nanos(crate::clock::system_s());
+        let now = nanos(crate::twin::clock::system_s());
         if let Err(e) = bag.write(ch, msg, now, now) {
             self.stop(&format!("{e:#}"));
         }

@@ -3,6 +3,7 @@
 
 pub mod bed_plot;
 pub mod csv;
-pub mod recorder;
+pub mod inflow;
+pub mod outputs;
 pub mod sweep_plot;
 pub mod vtk;

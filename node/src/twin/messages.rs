@@ -2,8 +2,10 @@
 //! gauge comparison. Quantities the solver could not give (a dry gauge, a column without sand)
 //! are NaN, as ROS float fields say "no value".
 
+use super::visual::bed_lines;
 use flume_msgs::flume_msgs::{BedProfile, ErodedMass, GaugeComparison, GaugeResidual};
 use flume_msgs::std_msgs::Header;
+use flume_msgs::visualization_msgs::MarkerArray;
 use flume_solver::Observations;
 
 fn nan_if_none(v: Option<f64>) -> f64 {
@@ -60,5 +62,33 @@ pub fn comparison(
                 }
             })
             .collect(),
+    }
+}
+
+/// The twin's outputs for one observation, in the order they go out.
+pub struct Outputs {
+    pub marker: MarkerArray,
+    pub bed: BedProfile,
+    /// None without an open flume.
+    pub eroded: Option<ErodedMass>,
+    pub comparison: GaugeComparison,
+}
+
+impl Outputs {
+    /// The outputs of `obs` under `header`, each gauge compared with `measured` (its reading
+    /// at the output's time) and marked `stale`.
+    pub fn of(
+        obs: &Observations,
+        header: Header,
+        measured: &[Option<f64>],
+        stale: &[bool],
+    ) -> Outputs {
+        let bed = bed_profile(obs, header.clone());
+        Outputs {
+            marker: bed_lines(&header, &bed.x_m, &bed.zs_m, &bed.zw_m),
+            eroded: eroded_mass(obs, header.clone()),
+            comparison: comparison(obs, measured, stale, header),
+            bed,
+        }
     }
 }

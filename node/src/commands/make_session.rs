@@ -22,9 +22,9 @@
 //! A check against the experiment: the paper's front took 8 s to reach the end of the flume
 //! at 2 m3/h; this model's front takes about 10 s to reach the weir of `ulbra_flume.yaml`.
 
-use crate::bag::BagWriter;
+use crate::adapters::bag::BagWriter;
+use crate::adapters::topics;
 use crate::cli::MakeSessionArgs;
-use crate::topics;
 use anyhow::{Context, Result, bail};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::flume_msgs::{Discharge, WaterLevel};
@@ -280,7 +280,7 @@ pub fn run(args: &MakeSessionArgs) -> Result<()> {
     for k in 0..=ticks {
         let t = k as f64 / GAUGE_RATE_HZ;
         let h = header(t)?;
-        let log_ns = crate::bag::writer::nanos(start + t + LATENCY_S);
+        let log_ns = crate::adapters::bag::writer::nanos(start + t + LATENCY_S);
         let stamp_ns = h.stamp.as_nanos().unwrap_or(0);
         if k % every == 0 {
             let q = model.discharge(t) * (1.0 + INFLOW_SIGMA_REL * noise.gaussian());

@@ -80,7 +80,7 @@ impl fmt::Display for Rejection {
 /// The checks: limits from the case and the node's settings.
 #[derive(Debug, Clone)]
 pub struct Limits {
-    /// The largest discharge the twin takes, m3/s (the inlet's Mach bound).
+    /// The largest discharge the twin takes, m3/s: the solver's limit for the inlet.
     pub max_discharge_m3_per_s: f64,
     /// Flume height, m: a level outside 0..height is a sensor fault.
     pub flume_height_m: f64,
@@ -93,9 +93,8 @@ impl Limits {
     pub fn for_case(case: &flume_solver::Case, future_tolerance_s: f64) -> Limits {
         let vertical = case.dim() - 1;
         Limits {
-            max_discharge_m3_per_s: case.open_flume.as_ref().map_or(f64::INFINITY, |f| {
-                flume_solver::max_inflow_m3_per_s(f, flume_solver::derive(case).c0)
-            }),
+            max_discharge_m3_per_s: flume_solver::inflow_limit_m3_per_s(case)
+                .unwrap_or(f64::INFINITY),
             flume_height_m: case.domain.max_m[vertical] - case.domain.min_m[vertical],
             future_tolerance_s,
         }
@@ -251,30 +250,6 @@ pub struct GaugeSample {
     pub reading: Reading,
 }
 
-/// A gauge's accepted readings, oldest first, from the one in force at the last output on.
-#[derive(Debug, Clone, Default)]
-pub struct Readings(std::collections::VecDeque<(f64, f64)>);
-
-impl Readings {
-    pub fn push(&mut self, stamp_s: f64, level_m: f64) {
-        self.0.push_back((stamp_s, level_m));
-    }
-
-    /// The newest stamp heard, s.
-    pub fn newest(&self) -> Option<f64> {
-        self.0.back().map(|r| r.0)
-    }
-
-    /// The level in force at `t` (the last reading stamped at or before it), forgetting the
-    /// readings it supersedes: outputs come in time order.
-    pub fn at(&mut self, t: f64) -> Option<f64> {
-        while self.0.len() > 1 && self.0[1].0 <= t {
-            self.0.pop_front();
-        }
-        self.0.front().filter(|r| r.0 <= t).map(|r| r.1)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -364,20 +339,5 @@ mod tests {
             Err(Rejection::LevelOutsideFlume { .. })
         ));
         assert_eq!(g.refused_total(), 3);
-    }
-
-    #[test]
-    fn a_gauge_is_compared_with_its_reading_at_the_output_time() {
-        let mut r = Readings::default();
-        assert_eq!(r.at(1.0), None, "no reading yet");
-        r.push(1.0, 0.07);
-        r.push(1.2, 0.08);
-        r.push(1.4, 0.09);
-        assert_eq!(r.at(0.5), None, "before the first reading");
-        assert_eq!(r.at(1.1), Some(0.07));
-        assert_eq!(r.at(1.3), Some(0.08));
-        assert_eq!(r.newest(), Some(1.4));
-        assert_eq!(r.at(2.0), Some(0.09));
-        assert_eq!(r.0.len(), 1, "superseded readings are forgotten");
     }
 }

@@ -4,9 +4,10 @@
 //! record.
 
 pub mod reader;
+pub mod tap;
 pub mod writer;
 
-pub use reader::{Recorded, Recording};
+pub use reader::{BagFile, BagMessage};
 pub use writer::{BagWriter, TopicQos};
 
 #[cfg(test)]
@@ -45,7 +46,7 @@ mod tests {
         bag.finish().expect("finishes");
     }
 
-    fn levels(r: &Recording) -> Vec<f64> {
+    fn levels(r: &BagFile) -> Vec<f64> {
         r.messages
             .iter()
             .map(|m| m.decode::<WaterLevel>().expect("decodes").level_m)
@@ -60,7 +61,7 @@ mod tests {
     fn a_recording_reads_back_with_its_schema_and_qos() {
         let path = temp("whole.mcap");
         write(&path);
-        let r = Recording::read(&path).expect("reads");
+        let r = BagFile::read(&path).expect("reads");
         assert_eq!(r.damage, None);
         assert_eq!(
             levels(&r),
@@ -87,7 +88,7 @@ mod tests {
         // Cut in the middle: the chunks before the cut are whole.
         let cut = temp("cut.mcap");
         std::fs::write(&cut, &bytes[..bytes.len() / 2]).expect("writes");
-        let r = Recording::read(&cut).expect("a cut file is no error");
+        let r = BagFile::read(&cut).expect("a cut file is no error");
         let n = r.messages.len();
         assert!(
             (30..100).contains(&n) && n.is_multiple_of(10),
@@ -104,7 +105,7 @@ mod tests {
         flipped[bytes.len() / 2] ^= 0x10;
         let bad = temp("flipped.mcap");
         std::fs::write(&bad, &flipped).expect("writes");
-        let r = Recording::read(&bad).expect("a damaged file is no error");
+        let r = BagFile::read(&bad).expect("a damaged file is no error");
         let m = r.messages.len();
         assert!((30..100).contains(&m), "{m}");
         assert_eq!(
@@ -115,7 +116,7 @@ mod tests {
         // Not a recording at all.
         let junk = temp("junk.mcap");
         std::fs::write(&junk, b"not a recording").expect("writes");
-        let err = Recording::read(&junk).expect_err("refused");
+        let err = BagFile::read(&junk).expect_err("refused");
         assert!(
             err.to_string().contains("is not an MCAP recording"),
             "{err}"

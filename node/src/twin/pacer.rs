@@ -103,10 +103,34 @@ impl Pacer {
         self.target(sim_t, now) - sim_t
     }
 
+    /// Simulated time 0 is node-clock time `origin` (a replay's first sample, whether the
+    /// gate takes it or not).
+    pub fn start_at(&mut self, origin: f64) {
+        self.origin = Some(origin);
+    }
+
+    /// A discharge in force at t = 0: a replay that starts after it was sent.
+    pub fn hold(&mut self, q: f64) {
+        self.pending.push_back((0.0, q));
+    }
+
     /// One chunk of `len_s` from `sim_t` whatever the sensors say (a paused twin's single
     /// step), with the inputs stamped in it.
     pub fn step(&mut self, sim_t: f64, len_s: f64) -> Chunk {
-        let to_s = sim_t + len_s;
+        self.chunk_to(sim_t, sim_t + len_s)
+    }
+
+    /// The chunk from `sim_t` to `to_s` whatever the sensors say (a step, or a replay's
+    /// lock-step chunk), with the inputs stamped in it.
+    pub fn chunk_to(&mut self, sim_t: f64, to_s: f64) -> Chunk {
+        let inflow = self.due(sim_t, to_s);
+        // The free-running clock, if it runs, restarts from the chunk's end.
+        self.anchor = None;
+        Chunk { to_s, inflow }
+    }
+
+    /// The discharges stamped up to `to_s`; one stamped before `sim_t` is applied at once.
+    fn due(&mut self, sim_t: f64, to_s: f64) -> Vec<(f64, f64)> {
         let mut inflow = Vec::new();
         while let Some(&(t, q)) = self.pending.front() {
             if t > to_s {
@@ -115,9 +139,7 @@ impl Pacer {
             inflow.push((t.max(sim_t), q));
             self.pending.pop_front();
         }
-        // The free-running clock, if it runs, restarts from the step's end.
-        self.anchor = None;
-        Chunk { to_s, inflow }
+        inflow
     }
 
     /// The next chunk from `sim_t`, at most `max_chunk_s` long; None when the twin is where

@@ -7,7 +7,7 @@ use std::path::Path;
 
 /// One message as recorded: its topic, its type's schema name and its CDR bytes.
 #[derive(Debug, Clone)]
-pub struct Recorded {
+pub struct BagMessage {
     pub topic: String,
     pub schema_name: String,
     /// The definition the recording stores for the type.
@@ -18,7 +18,7 @@ pub struct Recorded {
     pub data: Vec<u8>,
 }
 
-impl Recorded {
+impl BagMessage {
     pub fn decode<M: DeserializeOwned>(&self) -> Result<M> {
         cdr::deserialize::<M>(&self.data).with_context(|| {
             format!(
@@ -31,16 +31,16 @@ impl Recorded {
 
 /// The readable part of a recording.
 #[derive(Debug)]
-pub struct Recording {
-    pub messages: Vec<Recorded>,
+pub struct BagFile {
+    pub messages: Vec<BagMessage>,
     /// Why reading stopped before the end, if it did.
     pub damage: Option<String>,
 }
 
-impl Recording {
+impl BagFile {
     /// Reads `path`. A file that is not an MCAP recording at all is an error; one damaged
     /// part way is not: its readable part comes back with `damage` saying what stopped it.
-    pub fn read(path: &Path) -> Result<Recording> {
+    pub fn read(path: &Path) -> Result<BagFile> {
         let bytes = std::fs::read(path)
             .with_context(|| format!("cannot read the recording {}", path.display()))?;
         if !bytes.starts_with(mcap::MAGIC) {
@@ -72,7 +72,7 @@ impl Recording {
                         }
                         None => (String::new(), std::sync::Arc::from(&[][..])),
                     };
-                    messages.push(Recorded {
+                    messages.push(BagMessage {
                         topic: m.channel.topic.clone(),
                         schema_name,
                         definition,
@@ -87,7 +87,7 @@ impl Recording {
                     });
                 }
                 Err(e) => {
-                    let last = messages.last().map_or(String::new(), |m: &Recorded| {
+                    let last = messages.last().map_or(String::new(), |m: &BagMessage| {
                         format!(" (the last logged at {} ns)", m.log_ns)
                     });
                     damage = Some(format!(
@@ -99,6 +99,6 @@ impl Recording {
                 }
             }
         }
-        Ok(Recording { messages, damage })
+        Ok(BagFile { messages, damage })
     }
 }

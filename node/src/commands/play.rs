@@ -9,11 +9,11 @@
 //! subscribers match before the first sample. The topics' QoS is the twin's table's
 //! (`topics.rs`), which is what our recordings offer.
 
-use crate::bag::{Recorded, Recording};
+use crate::adapters::bag::{BagFile, BagMessage};
+use crate::adapters::ros::args::RosArgs;
+use crate::adapters::ros::{dds_context, full_topic, qos, topic_name, type_name};
+use crate::adapters::topics;
 use crate::cli::ReplayArgs;
-use crate::ros_args::RosArgs;
-use crate::run::{dds_context, full_topic, qos, topic_name, type_name};
-use crate::topics;
 use anyhow::{Context as _, Result, anyhow, bail};
 use flume_msgs::RosMessage;
 use flume_msgs::builtin_interfaces::Time;
@@ -50,7 +50,7 @@ fn publisher<M: RosMessage + Serialize>(
     node: &mut Node,
     ros: &RosArgs,
     topic: &str,
-    topic_qos: crate::bag::TopicQos,
+    topic_qos: crate::adapters::bag::TopicQos,
 ) -> Result<Publisher<M>> {
     let q = qos(topic_qos);
     let t = node
@@ -65,14 +65,14 @@ fn publisher<M: RosMessage + Serialize>(
 }
 
 /// Whether `m` is a sensor's: a discharge, a level or a range.
-fn is_sensor(m: &Recorded) -> bool {
+fn is_sensor(m: &BagMessage) -> bool {
     [Discharge::DEF, WaterLevel::DEF, Range::DEF]
         .iter()
         .any(|d| m.schema_name == d.schema_name())
 }
 
 /// A sensor's message decoded (see [`is_sensor`]).
-fn payload(m: &Recorded) -> Result<Payload> {
+fn payload(m: &BagMessage) -> Result<Payload> {
     let s = m.schema_name.as_str();
     if s == Discharge::DEF.schema_name() {
         m.decode().map(Payload::Inflow)
@@ -94,13 +94,13 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
             "the player takes topic remaps only: its namespace, node name and parameters are ignored"
         );
     }
-    let recording = Recording::read(&args.recording)?;
+    let recording = BagFile::read(&args.recording)?;
     if let Some(damage) = &recording.damage {
         log::warn!("{damage}; playing what comes before it");
         eprintln!("warning: {damage}; playing what comes before it");
     }
     let selected = |topic: &str| args.topics.is_empty() || args.topics.iter().any(|t| t == topic);
-    let mut sensors: Vec<&Recorded> = Vec::new();
+    let mut sensors: Vec<&BagMessage> = Vec::new();
     let mut ignored: BTreeMap<&str, u64> = BTreeMap::new();
     for m in &recording.messages {
         if is_sensor(m) && selected(&m.topic) {

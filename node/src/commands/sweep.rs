@@ -2,10 +2,10 @@
 //! the eroded sediment mass each run ends with (the paper's Figure 10: eroded mass against
 //! ks/d50 in the ULBRA flume).
 
+use crate::adapters::files::{csv::field, sweep_plot};
+use crate::adapters::progress;
+use crate::adapters::table::{Table, sig};
 use crate::cli::SweepArgs;
-use crate::output::{csv::field, sweep_plot};
-use crate::progress;
-use crate::table::{Table, sig};
 use anyhow::{Context, Result, bail};
 use flume_solver::FlumeObservation;
 use flume_solver::{Case, GpuContext, Simulation};

@@ -1,12 +1,12 @@
 //! The solver on a thread of its own: GPU work never blocks the async runtime. The node sends
 //! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
 
-use crate::frames::{Frames, in_flume_frame};
-use crate::output::recorder::Recorder;
-use crate::visual::CloudPoint;
+use crate::adapters::files::outputs::OutputFiles;
+use crate::adapters::frames::{Frames, in_flume_frame};
+use crate::twin::visual::CloudPoint;
 use anyhow::{Context, Result};
 use flume_solver::Particles;
-use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation};
+use flume_solver::{Backend, Case, InflowSchedule, Observations, Simulation};
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::thread::JoinHandle;
@@ -53,12 +53,18 @@ pub struct FrameSettings {
 
 /// The solver thread's end of the channels, and what it says when it starts.
 pub struct SolverThread {
-    pub commands: mpsc::Sender<Command>,
+    pub link: SolverLink,
     pub reports: async_mpsc::UnboundedReceiver<Result<Report, String>>,
+    pub handle: JoinHandle<()>,
+}
+
+/// What the twin keeps of the solver: where its commands go, and what it said at the start.
+pub struct SolverLink {
+    pub commands: mpsc::Sender<Command>,
     pub adapter: String,
     pub particles: usize,
+    /// The observations at t = 0.
     pub first: Observations,
-    pub handle: JoinHandle<()>,
 }
 
 /// Starts the solver for `case` on its own thread; returns once the GPU is open and the case
@@ -77,12 +83,12 @@ pub fn spawn(
     let handle = std::thread::Builder::new()
         .name("flume-solver".into())
         .spawn(move || {
-            let started = (|| -> Result<(Backend, Simulation, Option<Recorder>)> {
+            let started = (|| -> Result<(Backend, Simulation, Option<OutputFiles>)> {
                 let backend = Backend::choose().context("cannot open a backend")?;
                 let sim = Simulation::new(backend.clone(), &case)
                     .context("cannot set up the simulation")?;
                 let recorder = match &out {
-                    Some(dir) => Some(Recorder::create(dir, &case, None)?),
+                    Some(dir) => Some(OutputFiles::create(dir, &case, None)?),
                     None => None,
                 };
                 Ok((backend, sim, recorder))
@@ -179,11 +185,13 @@ pub fn spawn(
         .context("the solver thread stopped while starting")?
         .map_err(|e| anyhow::anyhow!(e))?;
     Ok(SolverThread {
-        commands: cmd_tx,
+        link: SolverLink {
+            commands: cmd_tx,
+            adapter,
+            particles,
+            first,
+        },
         reports: rep_rx,
-        adapter,
-        particles,
-        first,
         handle,
     })
 }
@@ -194,7 +202,7 @@ fn sim_adapter(sim: &Simulation) -> String {
 
 fn observe(
     sim: &Simulation,
-    recorder: Option<&mut Recorder>,
+    recorder: Option<&mut OutputFiles>,
     k: u64,
 ) -> Result<Observations, String> {
     match recorder {
@@ -214,23 +222,22 @@ fn run_chunk(
 ) -> Result<(f64, u64, u64), String> {
     let started = Instant::now();
     let steps0 = sim.steps();
-    let mut refused = 0;
-    for &(t, q) in inflow {
-        if t > sim.time_s() {
-            sim.advance_to(t).map_err(|e| format!("{e}"))?;
-        }
-        if let Err(e) = sim.set_boundary_conditions(BoundaryConditions { inflow_m3_per_s: q }) {
-            refused += 1;
-            log::warn!("discharge {q} m3/s at t = {t:.3} s refused by the solver: {e}");
-        }
-    }
-    if to_s > sim.time_s() {
-        sim.advance_to(to_s).map_err(|e| format!("{e}"))?;
+    let schedule = InflowSchedule::new(inflow.to_vec());
+    let refused = sim
+        .advance_through(to_s, &schedule)
+        .map_err(|e| format!("{e}"))?;
+    for r in &refused {
+        log::warn!(
+            "discharge {} m3/s at t = {:.3} s refused by the solver: {}",
+            r.inflow_m3_per_s,
+            r.time_s,
+            r.error
+        );
     }
     Ok((
         started.elapsed().as_secs_f64(),
         sim.steps() - steps0,
-        refused,
+        refused.len() as u64,
     ))
 }
 

@@ -1,12 +1,14 @@
 //! `flume-twin simulate`: an offline run of a case, interval by interval.
 
+use crate::adapters::files::inflow::InflowSeries;
+use crate::adapters::files::{bed_plot, outputs::OutputFiles};
+use crate::adapters::progress;
+use crate::adapters::table::{Table, sci, sig};
 use crate::cli::SimulateArgs;
-use crate::inflow::InflowSeries;
-use crate::output::{bed_plot, recorder::Recorder};
-use crate::progress;
-use crate::table::{Table, sci, sig};
 use anyhow::{Context, Result, bail};
-use flume_solver::{Backend, BoundaryConditions, Case, Observations, Simulation, SolverError};
+use flume_solver::{
+    Backend, BoundaryConditions, Case, InflowSchedule, Observations, Simulation, SolverError,
+};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -52,7 +54,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         set_inflow(&mut sim, series, 0.0)?;
     }
 
-    let mut recorder = Recorder::create(&out_dir, &case, snapshot_every)?;
+    let mut recorder = OutputFiles::create(&out_dir, &case, snapshot_every)?;
     let interval_s = case.time.output_interval_s;
     // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
     let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;
@@ -114,24 +116,31 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     Ok(())
 }
 
-/// Advances to `target_s`, stopping at each change of the inflow series on the way to apply it
-/// at its own time.
+/// Advances to `target_s`, each change of the inflow series on the way applied at its own
+/// time; a discharge the inlet refuses ends the run.
 fn advance(
     sim: &mut Simulation,
     inflow: Option<&InflowSeries>,
     target_s: f64,
 ) -> Result<(), anyhow::Error> {
-    if let Some(series) = inflow {
-        for t in series.changes_between(sim.time_s(), target_s) {
-            sim.advance_to(t)?;
-            set_inflow(sim, series, t)?;
-        }
+    let Some(series) = inflow else {
+        sim.advance_to(target_s)?;
+        return Ok(());
+    };
+    let mut changes: Vec<(f64, f64)> = series
+        .changes_between(sim.time_s(), target_s)
+        .into_iter()
+        .map(|t| (t, series.discharge_at(t)))
+        .collect();
+    changes.push((target_s, series.discharge_at(target_s)));
+    let refused = sim.advance_through(target_s, &InflowSchedule::new(changes))?;
+    match refused.into_iter().next() {
+        Some(r) => Err(anyhow::Error::new(r.error).context(format!(
+            "the inflow series' discharge {} m3/s at t = {} s",
+            r.inflow_m3_per_s, r.time_s
+        ))),
+        None => Ok(()),
     }
-    sim.advance_to(target_s)?;
-    if let Some(series) = inflow {
-        set_inflow(sim, series, target_s)?;
-    }
-    Ok(())
 }
 
 fn set_inflow(sim: &mut Simulation, series: &InflowSeries, t_s: f64) -> Result<()> {

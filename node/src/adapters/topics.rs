@@ -2,7 +2,7 @@
 //! requested with (DESIGN.md's table). The node, the recorder and the session generator all
 //! read them here, so a recording says what the wire did.
 
-use crate::bag::TopicQos;
+use crate::adapters::bag::TopicQos;
 
 pub const INFLOW: &str = "inflow";
 /// A gauge's topic is `gauges/<name>`, the name in lower case.

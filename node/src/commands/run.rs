@@ -1,0 +1,580 @@
+//! `flume-twin run CASE [--ros-args ...]`: the twin as a ROS 2 node (ros2-client on tokio).
+//!
+//! Sensor samples come in on `inflow` and `gauges/<name>`, the solver's reports from its
+//! thread, service calls and ticks from the node: each goes to the [`Twin`], and what it gives
+//! back goes out as the bed profile, the eroded mass, the gauge comparison, `/clock` and, once
+//! a second, `/diagnostics`. This module knows topics and times, not SPH.
+
+use crate::adapters::bag::BagFile;
+use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
+use crate::adapters::ros::args::RosArgs;
+use crate::adapters::ros::{dds_context, full_topic, live_parameters, outlet, qos, subscription};
+use crate::adapters::topics;
+use crate::cli::{GaugeMsg, RunArgs};
+use crate::twin::gate::Limits;
+use crate::twin::samples::{Sample, decode, role};
+use crate::twin::settings::Settings;
+use crate::twin::solver_thread::{self, FrameSettings, Report};
+use crate::twin::{Options, Published, Service, Twin, gauge_names};
+use anyhow::{Context as _, Result, anyhow, bail};
+use flume_msgs::builtin_interfaces::Time;
+use flume_msgs::diagnostic_msgs::DiagnosticArray;
+use flume_msgs::flume_msgs::{BedProfile, Discharge, ErodedMass, GaugeComparison, WaterLevel};
+use flume_msgs::rosgraph_msgs::Clock;
+use flume_msgs::sensor_msgs::{PointCloud2, Range};
+use flume_msgs::std_srvs::{TriggerRequest, TriggerResponse};
+use flume_msgs::visualization_msgs::MarkerArray;
+use flume_solver::Case;
+use futures::stream::SelectAll;
+use futures::{Stream, StreamExt};
+use ros2_client::{
+    Name, Node, NodeName, NodeOptions, ParameterValue, RmwRequestId, Server, ServiceMapping,
+    ServiceTypeName, Subscription,
+};
+use std::path::PathBuf;
+use std::pin::Pin;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use tokio::sync::mpsc;
+
+pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
+    let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
+    if case.open_flume.is_none() {
+        bail!(
+            "{}: the twin needs an open flume (open_flume: in the case) for its inflow to drive",
+            args.case.display()
+        );
+    };
+    let ros = RosArgs::parse(ros_args).context("bad --ros-args")?;
+    let fqn = ros.node_fqn("flume_twin");
+    let gauges: Vec<String> = gauge_names(&case)
+        .iter()
+        .map(|g| g.to_lowercase())
+        .collect();
+    let limits = Limits::for_case(&case, args.future_tolerance_s);
+    // Range sensors are mounted at the flume's top unless a parameter says otherwise.
+    let settings = Settings::new(args, &gauges, limits.flume_height_m, &ros.parameters(&fqn)?)?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .context("cannot start the async runtime")?;
+    runtime.block_on(serve(args, case, ros, settings, limits))
+}
+
+/// Sets the node up on the wire around a new twin, then drives it.
+async fn serve(
+    args: &RunArgs,
+    case: Case,
+    ros: RosArgs,
+    settings: Settings,
+    limits: Limits,
+) -> Result<()> {
+    let namespace = ros.namespace.clone().unwrap_or_else(|| "/".into());
+    let node_name = ros.node_name.clone().unwrap_or_else(|| "flume_twin".into());
+    let gauge_names = gauge_names(&case);
+    let frames = (!args.no_frames).then(|| FrameSettings {
+        service: args.frames_service.clone(),
+        rate_hz: args.frames_rate_hz,
+    });
+    let solver = solver_thread::spawn(case, args.out.clone(), frames)?;
+    let (adapter, particles) = (&solver.link.adapter, solver.link.particles);
+    println!("adapter: {adapter}\nparticles: {particles}\nnode: {namespace} {node_name}");
+    let live = Arc::new(Mutex::new(settings.clone()));
+    let context = dds_context(args.loopback, args.domain_id)?;
+    let mut node = context
+        .new_node(
+            NodeName::new(&namespace, &node_name)
+                .map_err(|e| anyhow!("node name {namespace} {node_name}: {e}"))?,
+            live_parameters(NodeOptions::new().enable_rosout(true), &live),
+        )
+        .context("cannot create the ROS 2 node")?;
+    let spinner = node.spinner().context("cannot spin the node")?;
+    tokio::spawn(spinner.spin());
+    let full = |name: &str| full_topic(&namespace, &ros, name);
+    let use_sim_time = settings.use_sim_time;
+    let sensors = Sensors::subscribe(&mut node, &full, &gauge_names, args.gauge_msg, use_sim_time)?;
+    let mut tap = tap(args, &full, &gauge_names)?;
+    let outlets = Outlets::create(&mut node, &mut tap, &full, use_sim_time)?;
+    let servers = services(
+        &mut node,
+        &format!("{}/{node_name}", namespace.trim_end_matches('/')),
+    )?;
+    let heard = Arc::new(AtomicBool::new(false));
+    let (fallback, session_plays) =
+        start_session_for_silence(args, &gauge_names, &heard, use_sim_time);
+    // A player's clock may start before its first sample: t = 0 is the first sample.
+    let wait_for_sensors = args.wait_for_sensors || session_plays || use_sim_time;
+    println!(
+        "listening: {} and {} gauge topics",
+        full(topics::INFLOW),
+        gauge_names.len()
+    );
+    let options = Options {
+        gauge_names: gauge_names.clone(),
+        node_name,
+        wait_for_sensors,
+        max_chunk_s: args.max_chunk_s,
+        until: args.until,
+        cloud_rate_hz: args.cloud_rate_hz,
+        cloud_max_points: args.cloud_max_points,
+    };
+    let mut twin = Twin::new(options, limits, settings, solver.link);
+    let mut wire = Wire {
+        node: &node,
+        sensors: sensors.samples(&gauge_names),
+        clock: sensors.clock(),
+        requests: requests(&servers),
+        servers: &servers,
+        outlets,
+        tap,
+        heard,
+        fallback,
+        reports: solver.reports,
+        live,
+    };
+    drive(&mut twin, &mut wire).await?;
+    // Closing the solver's channel: it finishes its chunk and stops.
+    drop(twin);
+    wire.tap.finish()?;
+    if solver.handle.join().is_err() {
+        log::warn!("the solver thread panicked");
+    }
+    Ok(())
+}
+
+/// The node's recording (`--record`), its input channels opened for the sensors' topics.
+fn tap(args: &RunArgs, full: &dyn Fn(&str) -> String, gauge_names: &[String]) -> Result<Tap> {
+    let mut tap = Tap::create(args.record.as_deref())?;
+    let gauge_topics: Vec<String> = gauge_names
+        .iter()
+        .map(|g| full(&topics::gauge(g)))
+        .collect();
+    let inputs = input_channels(
+        &mut tap,
+        &full(topics::INFLOW),
+        &gauge_topics,
+        args.gauge_msg == GaugeMsg::Range,
+        topics::INFLOW_QOS,
+        topics::GAUGE_QOS,
+    )?;
+    tap.set_inputs(inputs);
+    Ok(tap)
+}
+
+/// Starts the recorded session that plays the sensors' part when none is heard, if there is
+/// one; its samples come on the receiver.
+fn start_session_for_silence(
+    args: &RunArgs,
+    gauge_names: &[String],
+    heard: &Arc<AtomicBool>,
+    on_sim_time: bool,
+) -> (mpsc::Receiver<Sample>, bool) {
+    let (to_twin, samples) = mpsc::channel::<Sample>(64);
+    let Some(path) = session_for_silence(args, on_sim_time) else {
+        return (samples, false);
+    };
+    let wait = Duration::from_secs_f64(args.silent_wait_s);
+    let gauges = gauge_names.to_vec();
+    tokio::spawn(play_when_silent(
+        path,
+        gauges,
+        wait,
+        Arc::clone(heard),
+        to_twin,
+    ));
+    (samples, true)
+}
+
+/// With no sensor on the network, a recorded session plays the sensors' part: the session to
+/// play, if there is one. On simulated time the session is the player's to play, on the wire.
+fn session_for_silence(args: &RunArgs, on_sim_time: bool) -> Option<PathBuf> {
+    if on_sim_time && !args.no_replay {
+        println!("use_sim_time: no recorded session plays the sensors here");
+    }
+    args.replay_when_silent
+        .clone()
+        .filter(|_| !args.no_replay && !on_sim_time)
+        .filter(|path| {
+            let exists = path.exists();
+            if !exists {
+                log::warn!(
+                    "{} does not exist: with no sensors the twin runs on the clock",
+                    path.display()
+                );
+            }
+            exists
+        })
+}
+
+/// The node's side while it runs: what it reads, and what it writes to.
+struct Wire<'a> {
+    node: &'a Node,
+    sensors: SelectAll<SensorStream<'a>>,
+    clock: ClockStream<'a>,
+    requests: SelectAll<ServiceStream<'a>>,
+    servers: &'a [TriggerServer],
+    outlets: Outlets,
+    tap: Tap,
+    /// Set at the first sample a real sensor sends: a recorded session playing stops.
+    heard: Arc<AtomicBool>,
+    fallback: mpsc::Receiver<Sample>,
+    reports: mpsc::UnboundedReceiver<Result<Report, String>>,
+    live: Arc<Mutex<Settings>>,
+}
+
+/// Hands each event to the twin and sends what it gives back, until Ctrl-C, SIGTERM or
+/// `--until`.
+async fn drive(twin: &mut Twin, wire: &mut Wire<'_>) -> Result<()> {
+    let mut shutdown = Box::pin(tokio::signal::ctrl_c());
+    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+        .context("cannot watch for SIGTERM")?;
+    let mut tick = tokio::time::interval(Duration::from_millis(20));
+    let mut status_tick = tokio::time::interval(Duration::from_secs(1));
+    let mut sim_time_change_said = false;
+    loop {
+        tokio::select! {
+            // In order: a player sends /clock just before a sample, on another writer, and
+            // the sample is judged on that clock. Nothing here comes fast enough to starve
+            // the branches after it.
+            biased;
+            _ = &mut shutdown => {
+                println!("interrupted at t = {:.3} s", twin.sim_t());
+                return Ok(());
+            }
+            _ = terminate.recv() => {
+                println!("terminated at t = {:.3} s", twin.sim_t());
+                return Ok(());
+            }
+            Some(r) = wire.clock.next() => match r {
+                Ok(t) => twin.clock(t)?,
+                Err(e) => log::warn!("/clock: a message could not be read: {e}"),
+            },
+            Some((topic, r)) = wire.sensors.next() => match r {
+                Ok(sample) => {
+                    if !wire.heard.swap(true, Ordering::Relaxed) {
+                        println!("sensors heard on {topic}");
+                    }
+                    wire.tap.input(&sample);
+                    twin.sample(&topic, &sample);
+                }
+                Err(e) => twin.undecodable(&topic, &e),
+            },
+            Some(sample) = wire.fallback.recv() => {
+                wire.tap.input(&sample);
+                twin.sample_at(sample.input(), crate::twin::clock::system_s());
+            }
+            Some(report) = wire.reports.recv() => {
+                let report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
+                if let Some(out) = twin.report(report) {
+                    let last = out.last;
+                    wire.outlets.publish(&mut wire.tap, out).await;
+                    if last {
+                        println!("reached t = {:.3} s (--until)", twin.sim_t());
+                        return Ok(());
+                    }
+                }
+            }
+            _ = tick.tick() => {
+                let live = wire.live.lock().unwrap_or_else(|p| p.into_inner()).clone();
+                twin.tick(live)?;
+            }
+            Some((which, id)) = wire.requests.next() => respond(twin, wire.servers, which, id).await?,
+            _ = status_tick.tick() => {
+                let kept = twin.settings().use_sim_time;
+                warn_sim_time_change(wire.node, kept, &mut sim_time_change_said);
+                let status = twin.status();
+                wire.outlets.diagnostics.send(&mut wire.tap, status).await;
+            }
+        }
+    }
+}
+
+/// Answers a service call with what the twin did.
+async fn respond(
+    twin: &mut Twin,
+    servers: &[TriggerServer],
+    which: Service,
+    id: Option<RmwRequestId>,
+) -> Result<()> {
+    let Some(id) = id else {
+        log::warn!("a {which:?} request could not be read");
+        return Ok(());
+    };
+    let (success, message) = twin.service(which)?;
+    println!("service {which:?}: {message}");
+    let response = TriggerResponse { success, message };
+    if let Err(e) = servers[which as usize]
+        .async_send_response(id, response)
+        .await
+    {
+        log::warn!("the {which:?} response could not be sent: {e:?}");
+    }
+    Ok(())
+}
+
+/// ROS lets `use_sim_time` change on a running node; the twin keeps the clock it started
+/// with, and says so once.
+fn warn_sim_time_change(node: &Node, kept: bool, said: &mut bool) {
+    let asked = node.get_parameter("use_sim_time");
+    if asked.is_some_and(|v| v != ParameterValue::Boolean(kept)) && !std::mem::replace(said, true) {
+        log::warn!(
+            "use_sim_time was changed on the running node: the twin keeps the clock it started with; restart it to change"
+        );
+    }
+}
+
+/// Every sensor topic as one stream of (topic, sample or why it could not be read).
+type SensorStream<'a> = Pin<Box<dyn Stream<Item = (String, Result<Sample, String>)> + Send + 'a>>;
+/// `/clock`'s times, or why a message could not be read.
+type ClockStream<'a> = Pin<Box<dyn Stream<Item = Result<f64, String>> + Send + 'a>>;
+/// Service calls: which, and the request's id when it could be read.
+type ServiceStream<'a> = Pin<Box<dyn Stream<Item = (Service, Option<RmwRequestId>)> + Send + 'a>>;
+type TriggerServer = Server<TriggerRequest, TriggerResponse>;
+
+/// The sensors' subscriptions: the inflow, each gauge (as levels or as ranges) and, on
+/// simulated time, `/clock`.
+struct Sensors {
+    inflow: Subscription<Discharge>,
+    levels: Vec<Subscription<WaterLevel>>,
+    ranges: Vec<Subscription<Range>>,
+    clock: Option<Subscription<Clock>>,
+}
+
+impl Sensors {
+    fn subscribe(
+        node: &mut Node,
+        full: &dyn Fn(&str) -> String,
+        gauge_names: &[String],
+        gauge_msg: GaugeMsg,
+        use_sim_time: bool,
+    ) -> Result<Sensors> {
+        let gauge_qos = qos(topics::GAUGE_QOS);
+        let mut sensors = Sensors {
+            inflow: subscription(node, full, topics::INFLOW, qos(topics::INFLOW_QOS))?,
+            levels: Vec::new(),
+            ranges: Vec::new(),
+            // ros2-client's own simulated time listens to /clock as builtin_interfaces/Time,
+            // which a player's rosgraph_msgs/Clock does not match; the node keeps its own.
+            clock: use_sim_time
+                .then(|| subscription(node, full, topics::CLOCK, qos(topics::STREAM_QOS)))
+                .transpose()?,
+        };
+        for g in gauge_names {
+            let topic = topics::gauge(g);
+            match gauge_msg {
+                GaugeMsg::WaterLevel => {
+                    sensors
+                        .levels
+                        .push(subscription(node, full, &topic, gauge_qos.clone())?)
+                }
+                GaugeMsg::Range => {
+                    sensors
+                        .ranges
+                        .push(subscription(node, full, &topic, gauge_qos.clone())?)
+                }
+            }
+        }
+        Ok(sensors)
+    }
+
+    fn samples(&self, gauge_names: &[String]) -> SelectAll<SensorStream<'_>> {
+        let error = |e: ros2_client::ReadError| format!("{e:?}");
+        let mut streams: Vec<SensorStream> =
+            vec![Box::pin(self.inflow.async_stream().map(move |r| {
+                let sample = r.map(|(m, _)| Sample::Inflow(m)).map_err(error);
+                ("inflow".to_string(), sample)
+            }))];
+        for (i, s) in self.levels.iter().enumerate() {
+            let name = gauge_names[i].clone();
+            streams.push(Box::pin(s.async_stream().map(move |r| {
+                let sample = r.map(|(m, _)| Sample::Level(i, m)).map_err(error);
+                (name.clone(), sample)
+            })));
+        }
+        for (i, s) in self.ranges.iter().enumerate() {
+            let name = gauge_names[i].clone();
+            streams.push(Box::pin(s.async_stream().map(move |r| {
+                let sample = r.map(|(m, _)| Sample::Range(i, m)).map_err(error);
+                (name.clone(), sample)
+            })));
+        }
+        futures::stream::select_all(streams)
+    }
+
+    fn clock(&self) -> ClockStream<'_> {
+        match &self.clock {
+            Some(sub) => Box::pin(sub.async_stream().map(|r| {
+                r.map(|(c, _)| c.clock.as_secs_f64())
+                    .map_err(|e| format!("{e:?}"))
+            })),
+            None => Box::pin(futures::stream::pending()),
+        }
+    }
+}
+
+/// The twin's publishers, each recorded through the tap when the node records.
+struct Outlets {
+    bed: Outlet<BedProfile>,
+    eroded: Outlet<ErodedMass>,
+    compare: Outlet<GaugeComparison>,
+    /// None on simulated time: the player owns /clock.
+    clock: Option<Outlet<Clock>>,
+    diagnostics: Outlet<DiagnosticArray>,
+    cloud: Outlet<PointCloud2>,
+    marker: Outlet<MarkerArray>,
+}
+
+impl Outlets {
+    fn create(
+        node: &mut Node,
+        tap: &mut Tap,
+        full: &dyn Fn(&str) -> String,
+        use_sim_time: bool,
+    ) -> Result<Outlets> {
+        Ok(Outlets {
+            bed: outlet(node, tap, full, topics::BED_PROFILE, topics::LATCHED_QOS)?,
+            eroded: outlet(node, tap, full, topics::ERODED_MASS, topics::OUTPUT_QOS)?,
+            compare: outlet(
+                node,
+                tap,
+                full,
+                topics::GAUGE_COMPARISON,
+                topics::OUTPUT_QOS,
+            )?,
+            clock: (!use_sim_time)
+                .then(|| outlet(node, tap, full, topics::CLOCK, topics::STREAM_QOS))
+                .transpose()?,
+            diagnostics: outlet(node, tap, full, topics::DIAGNOSTICS, topics::OUTPUT_QOS)?,
+            cloud: outlet(node, tap, full, topics::PARTICLES, topics::STREAM_QOS)?,
+            marker: outlet(node, tap, full, topics::BED_MARKER, topics::LATCHED_QOS)?,
+        })
+    }
+
+    /// What the twin gave back after a report, in the order a listener expects it.
+    async fn publish(&self, tap: &mut Tap, out: Published) {
+        if let Some(o) = &self.clock {
+            o.send(tap, out.clock).await;
+        }
+        if let Some(cloud) = out.cloud {
+            self.cloud.send(tap, cloud).await;
+        }
+        if let Some(o) = out.outputs {
+            self.marker.send(tap, o.marker).await;
+            self.bed.send(tap, o.bed).await;
+            if let Some(msg) = o.eroded {
+                self.eroded.send(tap, msg).await;
+            }
+            self.compare.send(tap, o.comparison).await;
+        }
+    }
+}
+
+/// The twin's services (std_srvs/Trigger) under the node's name, in [`Service::ALL`]'s order.
+fn services(node: &mut Node, node_path: &str) -> Result<Vec<TriggerServer>> {
+    Service::ALL
+        .iter()
+        .map(|s| {
+            let qos = qos(topics::OUTPUT_QOS);
+            let name =
+                Name::new(node_path, s.name()).map_err(|e| anyhow!("service {}: {e}", s.name()))?;
+            node.create_server::<TriggerRequest, TriggerResponse>(
+                ServiceMapping::Enhanced,
+                &name,
+                &ServiceTypeName::new("std_srvs", "Trigger"),
+                qos.clone(),
+                qos,
+            )
+            .with_context(|| format!("cannot offer the {} service", s.name()))
+        })
+        .collect()
+}
+
+fn requests(servers: &[TriggerServer]) -> SelectAll<ServiceStream<'_>> {
+    futures::stream::select_all(servers.iter().zip(Service::ALL).map(|(srv, which)| {
+        Box::pin(
+            srv.receive_request_stream()
+                .map(move |r| (which, r.ok().map(|(id, _)| id))),
+        ) as ServiceStream
+    }))
+}
+
+/// With no sensor heard for `wait`, plays the inflow and gauge topics of the recording at
+/// `path` as the sensors, at their recorded pace, restamped on this node's clock; stops at
+/// the first sample a real sensor sends.
+async fn play_when_silent(
+    path: PathBuf,
+    gauges: Vec<String>,
+    wait: Duration,
+    heard: Arc<AtomicBool>,
+    to_twin: tokio::sync::mpsc::Sender<Sample>,
+) {
+    tokio::time::sleep(wait).await;
+    if heard.load(Ordering::Relaxed) {
+        return;
+    }
+    let read = tokio::task::spawn_blocking({
+        let path = path.clone();
+        move || BagFile::read(&path)
+    })
+    .await;
+    let recording = match read {
+        Ok(Ok(r)) => r,
+        Ok(Err(e)) => {
+            log::error!("no sensors, and the session to replay cannot be read: {e:#}");
+            return;
+        }
+        Err(e) => {
+            log::error!("no sensors, and reading the session to replay failed: {e}");
+            return;
+        }
+    };
+    if let Some(damage) = &recording.damage {
+        log::warn!("{damage}; replaying what comes before it");
+    }
+    let mut samples: Vec<(u64, Sample)> = recording
+        .messages
+        .iter()
+        .filter_map(|m| role(m, &gauges).map(|r| (m, r)))
+        .filter_map(|(m, r)| match decode(m, r) {
+            Ok(s) => Some((m.log_ns, s)),
+            Err(e) => {
+                log::warn!("{e:#}");
+                None
+            }
+        })
+        .collect();
+    samples.sort_by_key(|(log_ns, _)| *log_ns);
+    let Some(first) = samples.first().map(|(_, s)| s.stamp().as_secs_f64()) else {
+        log::warn!(
+            "{} has no sensor topic of this case to replay",
+            path.display()
+        );
+        return;
+    };
+    let span = samples.last().map_or(0.0, |(_, s)| s.stamp().as_secs_f64()) - first;
+    println!(
+        "no sensors in {:.0} s: {} plays the sensors ({} samples over {span:.0} s)",
+        wait.as_secs_f64(),
+        path.display(),
+        samples.len()
+    );
+    let start = crate::twin::clock::system_s();
+    let started = Instant::now();
+    for (_, mut sample) in samples {
+        let offset = sample.stamp().as_secs_f64() - first;
+        if let Some(rest) = Duration::from_secs_f64(offset.max(0.0)).checked_sub(started.elapsed())
+        {
+            tokio::time::sleep(rest).await;
+        }
+        if heard.load(Ordering::Relaxed) {
+            println!("a sensor spoke: the recorded session stops");
+            return;
+        }
+        sample.set_stamp(Time::from_secs_f64(start + offset).unwrap_or_default());
+        if to_twin.send(sample).await.is_err() {
+            return;
+        }
+    }
+    println!("the recorded session has ended: the twin holds its last discharge");
+}
