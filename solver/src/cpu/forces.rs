@@ -13,9 +13,10 @@ use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
 use rayon::prelude::*;
 
-/// Particles per block handed to a thread: large enough to amortise the hand-out, small
-/// enough to balance a flume whose particles crowd in a few cells.
-const BLOCK: usize = 512;
+/// Particles per block handed to a thread: small enough to balance a flume whose sand costs
+/// more than its water (on the CI flume, two threads: blocks of 512 took 3.3 s, of 128 and of
+/// 64 2.5 s, the thread that finished first no longer falling asleep before the other).
+const BLOCK: usize = 64;
 
 /// What the force pass reads besides the particles' sides.
 pub struct Extra<'a> {

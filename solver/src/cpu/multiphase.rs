@@ -84,7 +84,7 @@ pub fn rheology_pass(
 }
 
 /// Particles per block handed to a thread, as in the force pass.
-const BLOCK: usize = 512;
+const BLOCK: usize = 64;
 
 /// What the rheology's neighbour loop reads.
 struct Pairs<'a> {

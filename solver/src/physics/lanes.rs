@@ -113,6 +113,17 @@ pub struct Lanes(pub [f32; LANES]);
 #[repr(C, align(32))]
 pub struct LaneMask(pub [u32; LANES]);
 
+/// `items` side by side, lane k taking item k by `put(lanes, k, item)`; lanes past their
+/// number repeat the last item (their results are computed and thrown away).
+#[inline(always)]
+pub fn pack<T, P: Default>(items: &[T], mut put: impl FnMut(&mut P, usize, &T)) -> P {
+    let mut out = P::default();
+    for k in 0..LANES {
+        put(&mut out, k, &items[k.min(items.len() - 1)]);
+    }
+    out
+}
+
 impl Lanes {
     #[inline(always)]
     pub fn from_fn(f: impl FnMut(usize) -> f32) -> Lanes {

@@ -12,7 +12,7 @@
 
 use super::eos::{pressure, tait_b};
 use super::kernel::Wendland;
-use super::lanes::{LANES, Lanes, Mask, Real};
+use super::lanes::{Lanes, Mask, Real, pack};
 use super::{Params, Viscosity};
 
 /// Result of one force pass, one entry per particle.
@@ -71,13 +71,10 @@ pub struct Side<L: Real = f32> {
 }
 
 impl Side<Lanes> {
-    /// Particles `sides` side by side; lanes past their number repeat the last one (their
-    /// sums are computed and thrown away).
+    /// Particles `sides` side by side ([`pack`]).
     #[inline(always)]
     pub fn lanes(sides: &[Side]) -> Side<Lanes> {
-        let mut out = Side::<Lanes>::default();
-        for k in 0..LANES {
-            let s = &sides[k.min(sides.len() - 1)];
+        pack(sides, |out: &mut Side<Lanes>, k, s| {
             for a in 0..3 {
                 out.x[a].0[k] = s.x[a];
                 out.v[a].0[k] = s.v[a];
@@ -91,8 +88,7 @@ impl Side<Lanes> {
             out.mass.0[k] = s.mass;
             out.mu.0[k] = s.mu;
             out.hydro.0[k] = s.hydro;
-        }
-        out
+        })
     }
 }
 

@@ -26,7 +26,7 @@ use crate::physics::Params;
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::phase_index;
 use crate::physics::kernel::Wendland;
-use crate::physics::lanes::{LANES, Lanes, Mask, Real};
+use crate::physics::lanes::{Lanes, Mask, Real, pack};
 
 /// The sediment model of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -103,12 +103,10 @@ impl<L: Real> Default for RheologySums<L> {
 }
 
 impl RheologySums<Lanes> {
-    /// The sums `sums` side by side; lanes past their number repeat the last one.
+    /// The sums `sums` side by side ([`pack`]).
     #[inline(always)]
     pub fn lanes(sums: &[RheologySums]) -> RheologySums<Lanes> {
-        let mut out = RheologySums::<Lanes>::default();
-        for k in 0..LANES {
-            let s = &sums[k.min(sums.len() - 1)];
+        pack(sums, |out: &mut RheologySums<Lanes>, k, s| {
             for a in 0..3 {
                 for b in 0..3 {
                     out.grad[a][b].0[k] = s.grad[a][b];
@@ -120,8 +118,7 @@ impl RheologySums<Lanes> {
             out.mixture_volume.0[k] = s.mixture_volume;
             out.kernel_mass.0[k] = s.kernel_mass;
             out.water_r.0[k] = s.water_r;
-        }
-        out
+        })
     }
 
     /// The sums of lane `k`.
@@ -148,19 +145,16 @@ pub struct RheologySide<L: Real = f32> {
 }
 
 impl RheologySide<Lanes> {
-    /// The sides `sides` side by side; lanes past their number repeat the last one.
+    /// The sides `sides` side by side ([`pack`]).
     #[inline(always)]
     pub fn lanes(sides: &[RheologySide]) -> RheologySide<Lanes> {
-        let mut out = RheologySide::<Lanes>::default();
-        for k in 0..LANES {
-            let s = &sides[k.min(sides.len() - 1)];
+        pack(sides, |out: &mut RheologySide<Lanes>, k, s| {
             for a in 0..3 {
                 out.x[a].0[k] = s.x[a];
                 out.v[a].0[k] = s.v[a];
             }
             out.sediment.0[k] = if s.sediment { u32::MAX } else { 0 };
-        }
-        out
+        })
     }
 }
 

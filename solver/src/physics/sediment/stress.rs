@@ -6,7 +6,7 @@ use super::rheology::Tensor3;
 use crate::physics::Params;
 use crate::physics::interaction::{PairGeometry, phase_index, wall_scale};
 use crate::physics::kernel::Wendland;
-use crate::physics::lanes::{LANES, Lanes, Real};
+use crate::physics::lanes::{Lanes, Real, pack};
 
 /// A particle (or [`LANES`](crate::physics::lanes::LANES) of them) as the stress divergence
 /// sees it: position, phase and `tau / rho^2`.
@@ -18,12 +18,10 @@ pub struct StressSide<L: Real = f32> {
 }
 
 impl StressSide<Lanes> {
-    /// The stress sides `sides` side by side; lanes past their number repeat the last one.
+    /// The stress sides `sides` side by side ([`pack`]).
     #[inline(always)]
     pub fn lanes(sides: &[StressSide]) -> StressSide<Lanes> {
-        let mut out = StressSide::<Lanes>::default();
-        for k in 0..LANES {
-            let s = &sides[k.min(sides.len() - 1)];
+        pack(sides, |out: &mut StressSide<Lanes>, k, s| {
             for a in 0..3 {
                 out.x[a].0[k] = s.x[a];
                 for b in 0..3 {
@@ -31,8 +29,7 @@ impl StressSide<Lanes> {
                 }
             }
             out.phase[k] = s.phase;
-        }
-        out
+        })
     }
 }
 
