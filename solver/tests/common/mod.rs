@@ -56,33 +56,50 @@ pub fn validation_path(name: &str) -> std::path::PathBuf {
         .join(name)
 }
 
-/// The CPU oracle's parameters for a simulation, read from the very uniform the GPU uses.
+/// The CPU oracle's parameters for a simulation, from its case file and what the case implies
+/// (`derive`, in f64), never from the uniform the backends run on: a field packed wrongly
+/// into the uniform then shows as a disagreement with the oracle instead of being copied
+/// into it.
 pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics::Params {
-    use flume_solver::gpu::params::{VISCOSITY_ARTIFICIAL, VISCOSITY_LAMINAR};
+    use flume_solver::config::{DensityDiffusion, Viscosity as CaseViscosity};
     use flume_solver::physics::{Params, Phase, Viscosity};
-    let p = sim.params();
-    let n_phases = sim.derived().phases.len();
+    let case = sim.case();
+    let derived = sim.derived();
+    let mut gravity = [0.0f32; 3];
+    for (g, v) in gravity.iter_mut().zip(&case.gravity_m_per_s2) {
+        *g = *v as f32;
+    }
+    let (delta, hydrostatic_diffusion) = match case.numerics.density_diffusion {
+        DensityDiffusion::None => (0.0, false),
+        DensityDiffusion::MolteniColagrossi2009 { delta } => (delta as f32, false),
+        DensityDiffusion::Fourtakas2019 { delta } => (delta as f32, true),
+    };
     Params {
-        dim: sim.case().dimension,
-        h: p.h,
-        c0: p.c0,
-        gravity: [p.gravity[0], p.gravity[1], p.gravity[2]],
-        delta: p.delta_h_c0 / (p.h * p.c0),
-        hydrostatic_diffusion: p.diffusion_mode == flume_solver::gpu::params::DIFFUSION_FOURTAKAS,
-        clamp_negative_pressure: p.clamp_pressure != 0,
-        viscosity: match p.viscosity_mode {
-            VISCOSITY_ARTIFICIAL => Viscosity::Artificial { alpha: p.alpha },
-            VISCOSITY_LAMINAR => Viscosity::Laminar,
-            _ => Viscosity::Multiphase { alpha: p.alpha },
+        dim: case.dimension,
+        h: derived.h as f32,
+        c0: derived.c0 as f32,
+        gravity,
+        delta,
+        hydrostatic_diffusion,
+        clamp_negative_pressure: case.numerics.clamp_negative_pressure,
+        viscosity: match case.numerics.viscosity {
+            CaseViscosity::Artificial { alpha } => Viscosity::Artificial {
+                alpha: alpha as f32,
+            },
+            CaseViscosity::Laminar => Viscosity::Laminar,
+            CaseViscosity::Multiphase { alpha } => Viscosity::Multiphase {
+                alpha: alpha as f32,
+            },
         },
-        cfl: p.cfl,
-        phases: p.phases[..n_phases]
+        cfl: case.numerics.cfl as f32,
+        phases: derived
+            .phases
             .iter()
             .map(|ph| Phase {
-                rho0: ph.rho0,
-                mass: ph.mass,
-                mu: ph.mu,
-                mobile: ph.mobile > 0.5,
+                rho0: ph.rho0 as f32,
+                mass: ph.mass as f32,
+                mu: ph.viscosity_pa_s as f32,
+                mobile: ph.mobile,
             })
             .collect(),
     }
