@@ -47,15 +47,19 @@ pub fn rheology_pass(
         vol: &vol,
         sides: &sides,
     };
-    let mut out = Vec::with_capacity(n);
+    // Every slot is written by its block.
+    let none = ParticleRheology {
+        stress: [[0.0; 3]; 3],
+        mu: 0.0,
+        region: 0,
+        held: false,
+    };
+    let mut out = vec![none; n];
     pool.install(|| {
-        (0..n)
-            .into_par_iter()
-            .step_by(BLOCK)
-            .map(|first| simd::dispatch(|| pairs.block(first, (first + BLOCK).min(n), held_before)))
-            .collect_into_vec(&mut out)
+        out.par_chunks_mut(BLOCK)
+            .enumerate()
+            .for_each(|(b, out)| simd::dispatch(|| pairs.block(b * BLOCK, out, held_before)));
     });
-    let mut out: Vec<ParticleRheology> = out.into_iter().flatten().collect();
     if release {
         let stage = Release::new(params, model);
         let released: Vec<bool> = pool.install(|| {
@@ -98,22 +102,22 @@ struct Pairs<'a> {
 }
 
 impl Pairs<'_> {
-    /// The rheology of particles `first..end`, in groups of one row of cells as the force
-    /// pass takes them: each lane sums its own neighbours in sorted order.
+    /// The rheology of the particles from `first` into `out`, in groups of one row of cells
+    /// as the force pass takes them: each lane sums its own neighbours in sorted order.
     #[inline(always)]
-    fn block(&self, first: usize, end: usize, held_before: &[bool]) -> Vec<ParticleRheology> {
+    fn block(&self, first: usize, out: &mut [ParticleRheology], held_before: &[bool]) {
         let (pass, grid, pos, vel) = (self.pass, self.grid, self.pos, self.vel);
-        let mut out = Vec::with_capacity(end - first);
+        let end = first + out.len();
         let mut start = first;
         while start < end {
             let group = grid.group(start, end, |k| self.sides[k].x);
             let sums = self.group(&group);
             for (lane, i) in group.range.clone().enumerate() {
-                out.push(pass.finish(&pos[i], &vel[i], &sums.lane(lane), held_before[i]));
+                let s = sums.lane(lane);
+                out[i - first] = pass.finish(&pos[i], &vel[i], &s, held_before[i]);
             }
             start = group.range.end;
         }
-        out
     }
 
     /// The sums of `group`, from each particle's own start.
