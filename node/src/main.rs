@@ -10,10 +10,12 @@ mod commands;
 mod twin;
 
 use clap::Parser;
+use std::os::unix::fs::DirBuilderExt;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
     keep_freed_memory();
+    give_mesa_a_runtime_dir();
     // ROS tools append `--ros-args ...`; it is ROS's grammar, not ours, so it goes around clap.
     let mut args: Vec<String> = std::env::args().collect();
     let ros_args = match args.iter().position(|a| a == "--ros-args") {
@@ -21,11 +23,9 @@ fn main() -> ExitCode {
         None => Vec::new(),
     };
     let cli = cli::Cli::parse_from(args);
-    // Warnings by default so a CI log shows solver trouble without drowning in detail.
-    env_logger::Builder::from_env(
-        env_logger::Env::default().default_filter_or("warn,rustdds=error"),
-    )
-    .init();
+    // Warnings by default so a CI log shows solver trouble without drowning in detail; from
+    // ros2-client, only the warnings that ask something of the user (see `QUIET`).
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(QUIET)).init();
     let result = match cli.command {
         cli::Command::Simulate(args) => commands::simulate::run(&args),
         cli::Command::Bench(args) => commands::bench::run(&args),
@@ -45,6 +45,15 @@ fn main() -> ExitCode {
     }
 }
 
+/// The default log filter. RustDDS warns about every peer it cannot reach on some interface.
+/// ros2-client warns when `ROS_DISTRO` is unset (no ROS install: nothing to match, and a
+/// distribution that differs is still an error), and for every service request that carries
+/// its id in the sample rather than in inline QoS (ros2-client's own clients do; the id it
+/// falls back to is the right one for them, and the node answers rmw_cyclonedds's clients
+/// through their own mapping).
+const QUIET: &str =
+    "warn,rustdds=error,ros2_client::distributions=error,ros2_client::service::wrappers=error";
+
 /// Keeps the memory the process frees for its own next allocations. The CPU backend builds a
 /// step's sorted state, sides and sums afresh each step, some hundred kilobytes each; glibc
 /// otherwise serves blocks that size with mmap, or hands the top of its heap back to the
@@ -57,6 +66,29 @@ fn keep_freed_memory() {
     unsafe {
         libc::mallopt(libc::M_MMAP_THRESHOLD, 64 << 20);
         libc::mallopt(libc::M_TRIM_THRESHOLD, 256 << 20);
+    }
+}
+
+/// Mesa's Vulkan device-select layer, loaded whenever the adapters are listed (even when the
+/// CPU backend is chosen), prints an error when `XDG_RUNTIME_DIR` is unset or not a directory,
+/// as it is under a service manager or `sudo`; it only looks for a display there. A private
+/// directory of our own quiets it.
+fn give_mesa_a_runtime_dir() {
+    let usable =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if usable {
+        return;
+    }
+    // SAFETY: getuid cannot fail.
+    let uid = unsafe { libc::getuid() };
+    let dir = std::env::temp_dir().join(format!("flume-twin-runtime-{uid}"));
+    let made = std::fs::DirBuilder::new()
+        .recursive(true)
+        .mode(0o700)
+        .create(&dir);
+    if made.is_ok() {
+        // SAFETY: no other thread runs yet; nothing reads the environment concurrently.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
     }
 }
 

@@ -104,7 +104,11 @@ fn remove_dead_nodes() {
 impl Frames {
     /// Offers frames of `count` particles on `service`, at most `rate_hz` per wall second.
     pub fn open(service: &str, count: usize, parked_phase: u32, rate_hz: f64) -> Result<Frames> {
-        // iceoryx2 says at info level that it runs on its default configuration.
+        // iceoryx2 warns when it finds no config file of its own and runs on its defaults,
+        // as its readers (its Python binding among them) then do: nothing to act on, so the
+        // look-up is quiet. A config file, when there is one, is still read.
+        set_log_level(LogLevel::Error);
+        Config::global_config();
         set_log_level(LogLevel::Warn);
         remove_dead_nodes();
         let node = NodeBuilder::new()
