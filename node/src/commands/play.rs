@@ -140,7 +140,9 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
                 NodeOptions::new(),
             )
             .context("cannot create the ROS 2 node")?;
-        tokio::spawn(node.spinner().context("cannot spin the node")?.spin());
+        // No spinner: it serves only parameters, which the player has none of, and it
+        // subscribes /clock as builtin_interfaces/Time, a clash with the player's
+        // rosgraph_msgs/Clock that RustDDS reports as an error.
         let clock = publisher::<Clock>(&mut node, &ros, topics::CLOCK, topics::STREAM_QOS)?;
         let mut wires: Vec<Wire> = Vec::new();
         let mut index: BTreeMap<&str, usize> = BTreeMap::new();

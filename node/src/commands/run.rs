@@ -8,7 +8,9 @@
 use crate::adapters::bag::BagFile;
 use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
 use crate::adapters::ros::args::RosArgs;
-use crate::adapters::ros::{dds_context, full_topic, live_parameters, outlet, qos, subscription};
+use crate::adapters::ros::parameters::{ParameterServices, ParameterStream, live_parameters};
+use crate::adapters::ros::services::{Call, Offered};
+use crate::adapters::ros::{dds_context, full_topic, outlet, qos, subscription};
 use crate::adapters::topics;
 use crate::cli::{GaugeMsg, RunArgs};
 use crate::twin::gate::Limits;
@@ -27,10 +29,7 @@ use flume_msgs::visualization_msgs::MarkerArray;
 use flume_solver::Case;
 use futures::stream::SelectAll;
 use futures::{Stream, StreamExt};
-use ros2_client::{
-    Name, Node, NodeName, NodeOptions, ParameterValue, RmwRequestId, Server, ServiceMapping,
-    ServiceTypeName, Subscription,
-};
+use ros2_client::{Node, NodeName, NodeOptions, ParameterValue, ServiceTypeName, Subscription};
 use std::path::PathBuf;
 use std::pin::Pin;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -89,17 +88,14 @@ async fn serve(
             live_parameters(NodeOptions::new().enable_rosout(true), &live),
         )
         .context("cannot create the ROS 2 node")?;
-    let spinner = node.spinner().context("cannot spin the node")?;
-    tokio::spawn(spinner.spin());
     let full = |name: &str| full_topic(&namespace, &ros, name);
     let use_sim_time = settings.use_sim_time;
     let sensors = Sensors::subscribe(&mut node, &full, &gauge_names, args.gauge_msg, use_sim_time)?;
     let mut tap = tap(args, &full, &gauge_names)?;
     let outlets = Outlets::create(&mut node, &mut tap, &full, use_sim_time)?;
-    let servers = services(
-        &mut node,
-        &format!("{}/{node_name}", namespace.trim_end_matches('/')),
-    )?;
+    let node_path = format!("{}/{node_name}", namespace.trim_end_matches('/'));
+    let servers = services(&mut node, &node_path)?;
+    let parameters = ParameterServices::create(&mut node, &node_path)?;
     let heard = Arc::new(AtomicBool::new(false));
     let (fallback, session_plays) =
         start_session_for_silence(args, &gauge_names, &heard, use_sim_time);
@@ -112,7 +108,7 @@ async fn serve(
     );
     let options = Options {
         gauge_names: gauge_names.clone(),
-        node_name,
+        node_name: node_path,
         wait_for_sensors,
         max_chunk_s: args.max_chunk_s,
         until: args.until,
@@ -126,6 +122,8 @@ async fn serve(
         clock: sensors.clock(),
         requests: requests(&servers),
         servers: &servers,
+        parameter_calls: parameters.calls(),
+        parameters: &parameters,
         outlets,
         tap,
         heard,
@@ -214,6 +212,8 @@ struct Wire<'a> {
     clock: ClockStream<'a>,
     requests: SelectAll<ServiceStream<'a>>,
     servers: &'a [TriggerServer],
+    parameter_calls: SelectAll<ParameterStream<'a>>,
+    parameters: &'a ParameterServices,
     outlets: Outlets,
     tap: Tap,
     /// Set at the first sample a real sensor sends: a recorded session playing stops.
@@ -279,7 +279,10 @@ async fn drive(twin: &mut Twin, wire: &mut Wire<'_>) -> Result<()> {
                 let live = wire.live.lock().unwrap_or_else(|p| p.into_inner()).clone();
                 twin.tick(live)?;
             }
-            Some((which, id)) = wire.requests.next() => respond(twin, wire.servers, which, id).await?,
+            Some((which, call)) = wire.requests.next() => respond(twin, wire.servers, which, call).await?,
+            Some(call) = wire.parameter_calls.next() => {
+                wire.parameters.answer(wire.node, &wire.live, call).await;
+            }
             _ = status_tick.tick() => {
                 let kept = twin.settings().use_sim_time;
                 warn_sim_time_change(wire.node, kept, &mut sim_time_change_said);
@@ -295,21 +298,14 @@ async fn respond(
     twin: &mut Twin,
     servers: &[TriggerServer],
     which: Service,
-    id: Option<RmwRequestId>,
+    call: Call<TriggerRequest>,
 ) -> Result<()> {
-    let Some(id) = id else {
-        log::warn!("a {which:?} request could not be read");
-        return Ok(());
-    };
     let (success, message) = twin.service(which)?;
     println!("service {which:?}: {message}");
     let response = TriggerResponse { success, message };
-    if let Err(e) = servers[which as usize]
-        .async_send_response(id, response)
-        .await
-    {
-        log::warn!("the {which:?} response could not be sent: {e:?}");
-    }
+    servers[which as usize]
+        .reply(call.mapping, call.id, response)
+        .await;
     Ok(())
 }
 
@@ -328,9 +324,9 @@ fn warn_sim_time_change(node: &Node, kept: bool, said: &mut bool) {
 type SensorStream<'a> = Pin<Box<dyn Stream<Item = (String, Result<Sample, String>)> + Send + 'a>>;
 /// `/clock`'s times, or why a message could not be read.
 type ClockStream<'a> = Pin<Box<dyn Stream<Item = Result<f64, String>> + Send + 'a>>;
-/// Service calls: which, and the request's id when it could be read.
-type ServiceStream<'a> = Pin<Box<dyn Stream<Item = (Service, Option<RmwRequestId>)> + Send + 'a>>;
-type TriggerServer = Server<TriggerRequest, TriggerResponse>;
+/// Service calls: which, and the call.
+type ServiceStream<'a> = Pin<Box<dyn Stream<Item = (Service, Call<TriggerRequest>)> + Send + 'a>>;
+type TriggerServer = Offered<TriggerRequest, TriggerResponse>;
 
 /// The sensors' subscriptions: the inflow, each gauge (as levels or as ranges) and, on
 /// simulated time, `/clock`.
@@ -475,28 +471,18 @@ fn services(node: &mut Node, node_path: &str) -> Result<Vec<TriggerServer>> {
     Service::ALL
         .iter()
         .map(|s| {
-            let qos = qos(topics::OUTPUT_QOS);
-            let name =
-                Name::new(node_path, s.name()).map_err(|e| anyhow!("service {}: {e}", s.name()))?;
-            node.create_server::<TriggerRequest, TriggerResponse>(
-                ServiceMapping::Enhanced,
-                &name,
-                &ServiceTypeName::new("std_srvs", "Trigger"),
-                qos.clone(),
-                qos,
-            )
-            .with_context(|| format!("cannot offer the {} service", s.name()))
+            let kind = ServiceTypeName::new("std_srvs", "Trigger");
+            Offered::create(node, node_path, s.name(), &kind, &qos(topics::OUTPUT_QOS))
         })
         .collect()
 }
 
 fn requests(servers: &[TriggerServer]) -> SelectAll<ServiceStream<'_>> {
-    futures::stream::select_all(servers.iter().zip(Service::ALL).map(|(srv, which)| {
-        Box::pin(
-            srv.receive_request_stream()
-                .map(move |r| (which, r.ok().map(|(id, _)| id))),
-        ) as ServiceStream
-    }))
+    futures::stream::select_all(
+        servers.iter().zip(Service::ALL).map(|(srv, which)| {
+            Box::pin(srv.calls().map(move |call| (which, call))) as ServiceStream
+        }),
+    )
 }
 
 /// With no sensor heard for `wait`, plays the inflow and gauge topics of the recording at

@@ -134,6 +134,35 @@ pub const PARAMETERS: [&str; 5] = [
     "use_sim_time",
 ];
 
+/// What a parameter means and what it accepts, as `ros2 param describe` shows it.
+pub fn describe(name: &str) -> Option<(&'static str, &'static str)> {
+    const POSITIVE: &str = "a positive number";
+    Some(match name {
+        "target_real_time_factor" => (
+            "the pace the twin keeps, as simulated seconds per wall second (1 = the flume's)",
+            POSITIVE,
+        ),
+        "publish_rate_hz" => ("how often the twin publishes its outputs, Hz", POSITIVE),
+        "stale_after_s" => (
+            "sensors silent this long are stale: the twin then runs on its clock at the target pace, s",
+            POSITIVE,
+        ),
+        "frame_id" => (
+            "the frame of the published profile, cloud and markers",
+            "not empty",
+        ),
+        "use_sim_time" => (
+            "the node's time is /clock; read at start, a change asks for a restart",
+            "true or false",
+        ),
+        _ if name.starts_with(MOUNT_HEIGHT) => (
+            "the height of the gauge's range sensor above the flume floor (its level is this minus the range), m",
+            POSITIVE,
+        ),
+        _ => return None,
+    })
+}
+
 /// The height of each gauge's range sensor above the floor for an in-process replay: the
 /// live twin's parameters
 /// `gauge_mount_height_m.<gauge>` (the gauge's name in lower case) from `--ros-args -p` or

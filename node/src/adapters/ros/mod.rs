@@ -1,23 +1,22 @@
 //! ROS 2 over DDS (ros2-client): the participant, topic names after the remaps, QoS, the
-//! publishers the twin records through its tap, and the node's parameters.
+//! publishers the twin records through its tap; the node's parameters and services are in
+//! [`parameters`] and [`services`].
 
 pub mod args;
+pub mod parameters;
+pub mod services;
 
 use crate::adapters::bag::TopicQos;
 use crate::adapters::bag::tap::{Outlet, Tap};
-use crate::twin::settings::Settings;
 use anyhow::{Context as _, Result, anyhow};
-use args::{ParamValue, RosArgs};
+use args::RosArgs;
 use flume_msgs::{MsgDef, RosMessage};
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::qos::{Durability, History, WhenFull};
-use ros2_client::{
-    Context, MessageTypeName, Name, Node, NodeOptions, ParameterValue, QosProfile, Subscription,
-};
+use ros2_client::{Context, MessageTypeName, Name, Node, QosProfile, Subscription};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use std::net::Ipv4Addr;
-use std::sync::{Arc, Mutex};
 
 /// A topic's QoS as ros2-client takes it.
 pub fn qos(t: TopicQos) -> QosProfile {
@@ -101,56 +100,4 @@ pub fn dds_context(loopback: bool, domain_id: u16) -> Result<Context> {
         Context::with_options(ros2_client::ContextOptions::new().domain_id(domain_id))
     }
     .context("cannot start ROS 2 (DDS)")
-}
-
-/// A parameter value from ROS as ours; arrays are none of our parameters.
-fn from_ros(value: &ParameterValue) -> Option<ParamValue> {
-    match value {
-        ParameterValue::Boolean(b) => Some(ParamValue::Bool(*b)),
-        ParameterValue::Integer(i) => Some(ParamValue::Integer(*i)),
-        ParameterValue::Double(d) => Some(ParamValue::Double(*d)),
-        ParameterValue::String(t) => Some(ParamValue::String(t.clone())),
-        _ => None,
-    }
-}
-
-/// One of our parameter values as ROS declares it.
-fn to_ros(value: ParamValue) -> ParameterValue {
-    match value {
-        ParamValue::Bool(b) => ParameterValue::Boolean(b),
-        ParamValue::Integer(i) => ParameterValue::Integer(i),
-        ParamValue::Double(d) => ParameterValue::Double(d),
-        ParamValue::String(t) => ParameterValue::String(t),
-    }
-}
-
-/// `ros2 param set` on a running node: the validator refuses with the reason, the action
-/// applies to the settings the loop reads.
-pub fn live_parameters(options: NodeOptions, live: &Arc<Mutex<Settings>>) -> NodeOptions {
-    let check = Arc::clone(live);
-    let set = Arc::clone(live);
-    let lock = |m: &Arc<Mutex<Settings>>| -> Settings {
-        m.lock().unwrap_or_else(|p| p.into_inner()).clone()
-    };
-    let initial = lock(live);
-    let mut options = options;
-    for (name, value) in initial.declared() {
-        options = options.declare_parameter(&name, to_ros(value));
-    }
-    options
-        .parameter_validator(Box::new(move |name, value| {
-            let value =
-                from_ros(value).ok_or_else(|| format!("{name}: arrays are not accepted"))?;
-            lock(&check)
-                .apply(name, &value)
-                .map_err(|r| format!("{name}: {r}"))
-        }))
-        .parameter_set_action(Box::new(move |name, value| {
-            let value =
-                from_ros(value).ok_or_else(|| format!("{name}: arrays are not accepted"))?;
-            let mut s = set.lock().unwrap_or_else(|p| p.into_inner());
-            s.apply(name, &value).map_err(|r| format!("{name}: {r}"))?;
-            log::info!("parameter {name} set to {value:?}");
-            Ok(())
-        }))
 }
