@@ -7,7 +7,7 @@
 use flume_msgs::RosMessage;
 mod common;
 
-use common::{gpu, repo_file};
+use common::{gpu, read_until, repo_file};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::DiagnosticArray;
 use flume_msgs::flume_msgs::GaugeComparison;
@@ -24,7 +24,6 @@ use ros2_client::{
     Context, MessageTypeName, Name, Node, NodeName, NodeOptions, Parameter, ParameterValue,
     QosProfile, ServiceMapping, ServiceTypeName,
 };
-use std::io::{BufRead, BufReader};
 use std::net::Ipv4Addr;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
@@ -95,9 +94,11 @@ where
 {
     tokio::time::timeout(Duration::from_secs(20), async {
         while let Some(Ok((msg, _))) = stream.next().await {
+            // Only this test's twin: any other on the network reports on /diagnostics too.
             let value = msg
                 .status
                 .iter()
+                .filter(|s| s.name.starts_with("/flume_params/flume_twin"))
                 .flat_map(|s| &s.values)
                 .find_map(|kv| (kv.key == key).then(|| kv.value.clone()));
             if let Some(v) = value.filter(|v| accept(v)) {
@@ -164,15 +165,7 @@ fn control_the_twin() -> Result<(), Unmatched> {
     // This side's DDS participant starts after the twin's: when it came first, on a loaded
     // machine the twin's parameter services were at times never matched (RustDDS discovery).
     // The twin prints `node:` just before it starts DDS; the rest of its output is drained.
-    let mut lines = BufReader::new(twin.0.stdout.take().expect("stdout")).lines();
-    loop {
-        match lines.next() {
-            Some(Ok(line)) if line.starts_with("node:") => break,
-            Some(Ok(_)) => continue,
-            _ => panic!("the twin ended before starting its node"),
-        }
-    }
-    std::thread::spawn(move || lines.for_each(drop));
+    let _drained = read_until(twin.0.stdout.take().expect("stdout"), "node:");
     std::thread::sleep(Duration::from_secs(2));
     let runtime = tokio::runtime::Runtime::new().expect("runtime");
     runtime.block_on(async {

@@ -353,7 +353,7 @@ def main() -> None:
                     body = {"t": s.clock.sec + s.clock.nanosec * 1e-9}
                 else:
                     body = {"t": secs(s.header), "status": [
-                        {"level": st.level, "message": st.message,
+                        {"name": st.name, "level": st.level, "message": st.message,
                          "values": {kv.key: kv.value for kv in st.values}} for st in s.status]}
                 emit(kind, body)
         time.sleep(0.01)

@@ -45,7 +45,8 @@ pub fn gauge_names(case: &flume_solver::Case) -> Vec<String> {
 pub struct Options {
     /// The case's gauges, by name, in the case's order.
     pub gauge_names: Vec<String>,
-    /// The node's name, as /diagnostics names the twin.
+    /// The node's name, as /diagnostics names the twin: fully qualified, since every twin on
+    /// the network reports on the one /diagnostics topic.
     pub node_name: String,
     /// Hold at t = 0 until the first sensor sample.
     pub wait_for_sensors: bool,

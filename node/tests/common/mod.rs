@@ -212,3 +212,29 @@ impl Drop for Proc {
         let _ = self.child.wait();
     }
 }
+
+/// Reads a child's output up to the first line that starts with `prefix` and returns it, with
+/// a thread that drains the rest (a full pipe would stall the child) and gives it back at the
+/// end. Panics if the output ends first.
+pub fn read_until(
+    out: std::process::ChildStdout,
+    prefix: &str,
+) -> (String, std::thread::JoinHandle<String>) {
+    use std::io::{BufRead, Read};
+    let mut out = std::io::BufReader::new(out);
+    let mut seen = String::new();
+    loop {
+        let start = seen.len();
+        let read = out.read_line(&mut seen).expect("the child's output");
+        assert!(read > 0, "the output ended before {prefix:?}:\n{seen}");
+        if seen[start..].starts_with(prefix) {
+            break;
+        }
+    }
+    let rest = std::thread::spawn(move || {
+        let mut rest = String::new();
+        let _ = out.read_to_string(&mut rest);
+        rest
+    });
+    (seen, rest)
+}
