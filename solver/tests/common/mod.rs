@@ -105,32 +105,43 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
     }
 }
 
-/// The CPU oracle's sediment model, read from the uniform the GPU uses.
+/// The sediment model the case file describes, for the CPU oracle: read from the case and
+/// `derive()` like [`reference_params`], never from the uniform the backends run on, so a
+/// field packed wrongly into the uniform fails the stage tests.
 pub fn reference_sediment(
     sim: &flume_solver::Simulation,
 ) -> flume_solver::physics::sediment::pass::SedimentModel {
+    use flume_solver::config::YieldCriterion;
     use flume_solver::physics::sediment::SedimentParams;
-    let s = sim.params().sediment;
-    let mass = sim.params().phases[s.phase as usize].mass;
+    let case = sim.case();
+    let derived = sim.derived();
+    let (k_sed, k_water) = case.sediment_phases().expect("a case with sediment");
+    let (sed, water) = (&case.phases[k_sed], &case.phases[k_water]);
+    let cfg = sed.sediment.as_ref().expect("the sediment phase's model");
+    // MODEL.md: without a cap, mu_max = 0.125 h rho_s c0.
+    let mu_max = cfg
+        .max_viscosity_pa_s
+        .unwrap_or(0.125 * derived.h * sed.rho0_kg_per_m3 * derived.c0);
     flume_solver::physics::sediment::pass::SedimentModel {
         material: SedimentParams {
-            rho_s: s.rho_s,
-            d50_m: s.d50,
-            phi_rad: s.phi,
-            cohesion_pa: 0.0,
-            hbp_m: s.hbp_m,
-            hbp_n: s.hbp_n,
-            mu_s_pa_s: s.mu_s,
-            ks_over_d50: s.ks / s.d50,
-            surface_mass_fraction: s.surface_mass / mass,
-            rho_w: s.rho_w,
-            nu_w: s.nu_w,
-            mu_w: s.mu_w,
+            rho_s: sed.rho0_kg_per_m3 as f32,
+            d50_m: cfg.d50_m as f32,
+            phi_rad: cfg.friction_angle_deg.to_radians() as f32,
+            cohesion_pa: cfg.cohesion_pa as f32,
+            hbp_m: cfg.hbp_m_s as f32,
+            hbp_n: cfg.hbp_n as f32,
+            mu_s_pa_s: sed.viscosity_pa_s as f32,
+            ks_over_d50: cfg.ks_over_d50 as f32,
+            surface_mass_fraction: cfg.surface_mass_fraction as f32,
+            rho_w: water.rho0_kg_per_m3 as f32,
+            nu_w: (water.viscosity_pa_s / water.rho0_kg_per_m3) as f32,
+            mu_w: water.viscosity_pa_s as f32,
         },
-        sediment_phase: s.phase as usize,
-        water_phase: s.water_phase as usize,
-        shields_only: s.shields_only != 0,
-        mu_max: s.mu_max,
+        // Phase 0 is the walls: the case's phases count from 1.
+        sediment_phase: k_sed + 1,
+        water_phase: k_water + 1,
+        shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
+        mu_max: mu_max as f32,
     }
 }
 
