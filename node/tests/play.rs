@@ -323,7 +323,7 @@ fn publish_takes_no_twin_options_and_a_replay_checks_its_mounts() {
         .expect("runs");
     assert!(!out.status.success());
     assert!(
-        printed(&out).contains("gauge_mount_height_m.p1 must be a positive number"),
+        printed(&out).contains("gauge_mount_height_m.p1: must be a positive number"),
         "{}",
         printed(&out)
     );

@@ -135,7 +135,9 @@ async fn serve(
     // Closing the solver's channel: it finishes its chunk and stops.
     drop(twin);
     wire.tap.finish()?;
-    if solver.handle.join().is_err() {
+    // Waiting for it is blocking work: off the async runtime's threads.
+    let joined = tokio::task::spawn_blocking(move || solver.handle.join()).await;
+    if !matches!(joined, Ok(Ok(()))) {
         log::warn!("the solver thread panicked");
     }
     Ok(())

@@ -38,21 +38,31 @@ impl Settings {
             mount_height_m: vec![flume_top_m; gauges.len()],
             use_sim_time: false,
         };
+        s.apply_at_start(params, |_| true)?;
+        Ok(s)
+    }
+
+    /// Applies the parameters given at start (files, `-p`) that `wanted` names. A name that is
+    /// none of the node's, or a gauge this case does not have, is said and skipped: a
+    /// parameter file may serve several cases. A bad value is an error.
+    fn apply_at_start(
+        &mut self,
+        params: &[(String, ParamValue)],
+        wanted: impl Fn(&str) -> bool,
+    ) -> Result<()> {
         for (name, value) in params {
-            let gauge = name.strip_prefix(MOUNT_HEIGHT);
-            let known = match gauge {
-                // A parameter file may serve cases with more gauges than this one.
-                Some(g) => s.gauges.iter().any(|n| n == g),
+            let known = match name.strip_prefix(MOUNT_HEIGHT) {
+                Some(g) => self.gauges.iter().any(|n| n == g),
                 None => PARAMETERS.contains(&name.as_str()),
             };
             if !known {
                 log::warn!("parameter {name} is not one of flume_twin's for this case; ignored");
-                continue;
+            } else if wanted(name) {
+                self.apply(name, value)
+                    .map_err(|reason| anyhow!("parameter {name}: {reason}"))?;
             }
-            s.apply(name, value)
-                .map_err(|reason| anyhow!("parameter {name}: {reason}"))?;
         }
-        Ok(s)
+        Ok(())
     }
 
     /// The settings of an in-process replay: the gauges' mount heights and when a gauge is
@@ -169,25 +179,11 @@ pub fn describe(name: &str) -> Option<(&'static str, &'static str)> {
 /// `--params-file`, else the flume's top. The node's other parameters mean nothing to an
 /// in-process replay and are ignored; a name that is none of the node's is said.
 pub fn mount_heights(ros: &RosArgs, gauges: &[String], flume_top_m: f64) -> Result<Vec<f64>> {
-    let mut heights = vec![flume_top_m; gauges.len()];
-    for (name, value) in ros.parameters(&ros.node_fqn("flume_twin"))? {
-        let Some(gauge) = name.strip_prefix(MOUNT_HEIGHT) else {
-            if !PARAMETERS.contains(&name.as_str()) {
-                log::warn!("{name} is not a parameter of flume_twin: ignored");
-            }
-            continue;
-        };
-        // A parameter file may serve cases with more gauges than this one.
-        let Some(k) = gauges.iter().position(|g| g.to_lowercase() == gauge) else {
-            log::warn!("{name}: this case has no gauge {gauge}: ignored");
-            continue;
-        };
-        heights[k] = value
-            .as_f64()
-            .filter(|h| h.is_finite() && *h > 0.0)
-            .ok_or_else(|| anyhow!("{name} must be a positive number, got {value:?}"))?;
-    }
-    Ok(heights)
+    let names: Vec<String> = gauges.iter().map(|g| g.to_lowercase()).collect();
+    let mut s = Settings::for_replay(&names, vec![flume_top_m; names.len()], f64::INFINITY);
+    let params = ros.parameters(&ros.node_fqn("flume_twin"))?;
+    s.apply_at_start(&params, |name| name.starts_with(MOUNT_HEIGHT))?;
+    Ok(s.mount_height_m)
 }
 
 #[cfg(test)]

@@ -83,96 +83,26 @@ pub fn spawn(
     let handle = std::thread::Builder::new()
         .name("flume-solver".into())
         .spawn(move || {
-            let started = (|| -> Result<(Backend, Simulation, Option<OutputFiles>)> {
-                let backend = Backend::choose().context("cannot open a backend")?;
-                let sim = Simulation::new(backend.clone(), &case)
-                    .context("cannot set up the simulation")?;
-                let recorder = match &out {
-                    Some(dir) => Some(OutputFiles::create(dir, &case, None)?),
-                    None => None,
-                };
-                Ok((backend, sim, recorder))
-            })();
-            let (backend, mut sim, mut recorder) = match started {
-                Ok(s) => s,
+            let mut worker = match Worker::start(case, out.as_deref()) {
+                Ok(w) => w,
                 Err(e) => {
-                    let _ = ready_tx.send(Err(format!("{e:#}")));
+                    let _ = ready_tx.send(Err(e));
                     return;
                 }
             };
-            let first = observe(&sim, recorder.as_mut(), 0);
-            let adapter = sim_adapter(&sim);
-            match first {
+            let said = (worker.sim.backend_name(), worker.sim.particle_count());
+            match worker.observe() {
                 Ok(obs) => {
-                    let _ = ready_tx.send(Ok((adapter, sim.particle_count(), obs)));
+                    let _ = ready_tx.send(Ok((said.0, said.1, obs)));
                 }
                 Err(e) => {
                     let _ = ready_tx.send(Err(e));
                     return;
                 }
             }
-            let mut k = 0;
-            let parked = sim.parked_phase();
-            let mut frames = frames.and_then(|f| {
-                match Frames::open(
-                    &f.service,
-                    sim.particle_count(),
-                    parked.unwrap_or(0),
-                    f.rate_hz,
-                ) {
-                    Ok(fr) => {
-                        println!("particle frames: iceoryx2 service {}", f.service);
-                        Some(fr)
-                    }
-                    Err(e) => {
-                        log::error!("no particle frames for visualisers: {e:#}");
-                        None
-                    }
-                }
-            });
+            worker.open_frames(frames);
             while let Ok(command) = cmd_rx.recv() {
-                k += 1;
-                let report = match command {
-                    Command::Advance {
-                        to_s,
-                        inflow,
-                        cloud,
-                    } => run_chunk(&mut sim, to_s, &inflow).and_then(|(wall_s, steps, refused)| {
-                        let particles = read_back(&sim, cloud, frames.as_mut())?;
-                        let cloud = particles
-                            .as_ref()
-                            .filter(|_| cloud)
-                            .map(|p| cloud_points(&sim, p, parked));
-                        observe(&sim, recorder.as_mut(), k).map(|obs| Report {
-                            obs,
-                            wall_s,
-                            steps,
-                            refused_inflows: refused,
-                            cloud,
-                            reset: false,
-                            frames_sent: frames.as_ref().map_or(0, |f| f.sent),
-                            frames_skipped: frames.as_ref().map_or(0, |f| f.skipped),
-                        })
-                    }),
-                    Command::Reset => {
-                        let started = Instant::now();
-                        Simulation::new(backend.clone(), &case)
-                            .map_err(|e| format!("cannot rebuild the case: {e}"))
-                            .and_then(|fresh| {
-                                sim = fresh;
-                                observe(&sim, recorder.as_mut(), k).map(|obs| Report {
-                                    obs,
-                                    wall_s: started.elapsed().as_secs_f64(),
-                                    steps: 0,
-                                    refused_inflows: 0,
-                                    cloud: None,
-                                    reset: true,
-                                    frames_sent: frames.as_ref().map_or(0, |f| f.sent),
-                                    frames_skipped: frames.as_ref().map_or(0, |f| f.skipped),
-                                })
-                            })
-                    }
-                };
+                let report = worker.handle(command);
                 let failed = report.is_err();
                 if rep_tx.send(report).is_err() || failed {
                     return;
@@ -196,20 +126,115 @@ pub fn spawn(
     })
 }
 
-fn sim_adapter(sim: &Simulation) -> String {
-    sim.backend_name()
+/// What the solver thread holds: the case (to reset to), the simulation, and its outputs.
+struct Worker {
+    case: Case,
+    backend: Backend,
+    sim: Simulation,
+    recorder: Option<OutputFiles>,
+    frames: Option<Frames>,
+    /// Chunks handled, the row number of the CSV files.
+    chunks: u64,
 }
 
-fn observe(
-    sim: &Simulation,
-    recorder: Option<&mut OutputFiles>,
-    k: u64,
-) -> Result<Observations, String> {
-    match recorder {
-        Some(r) => r.record(sim, k).map_err(|e| format!("{e:#}")),
-        None => sim
-            .observe()
-            .map_err(|e| format!("cannot read the observations back from the GPU: {e}")),
+impl Worker {
+    fn start(case: Case, out: Option<&std::path::Path>) -> Result<Worker, String> {
+        let started = (|| -> Result<Worker> {
+            let backend = Backend::choose().context("cannot open a backend")?;
+            let sim =
+                Simulation::new(backend.clone(), &case).context("cannot set up the simulation")?;
+            let recorder = out
+                .map(|dir| OutputFiles::create(dir, &case, None))
+                .transpose()?;
+            Ok(Worker {
+                case,
+                backend,
+                sim,
+                recorder,
+                frames: None,
+                chunks: 0,
+            })
+        })();
+        started.map_err(|e| format!("{e:#}"))
+    }
+
+    fn open_frames(&mut self, settings: Option<FrameSettings>) {
+        let parked = self.sim.parked_phase().unwrap_or(0);
+        let count = self.sim.particle_count();
+        self.frames =
+            settings.and_then(
+                |f| match Frames::open(&f.service, count, parked, f.rate_hz) {
+                    Ok(fr) => {
+                        println!("particle frames: iceoryx2 service {}", f.service);
+                        Some(fr)
+                    }
+                    Err(e) => {
+                        log::error!("no particle frames for visualisers: {e:#}");
+                        None
+                    }
+                },
+            );
+    }
+
+    fn handle(&mut self, command: Command) -> Result<Report, String> {
+        self.chunks += 1;
+        match command {
+            Command::Advance {
+                to_s,
+                inflow,
+                cloud,
+            } => self.advance(to_s, &inflow, cloud),
+            Command::Reset => {
+                let started = Instant::now();
+                self.sim = Simulation::new(self.backend.clone(), &self.case)
+                    .map_err(|e| format!("cannot rebuild the case: {e}"))?;
+                let mut report = self.report(started.elapsed().as_secs_f64(), 0, 0, None)?;
+                report.reset = true;
+                Ok(report)
+            }
+        }
+    }
+
+    fn advance(&mut self, to_s: f64, inflow: &[(f64, f64)], cloud: bool) -> Result<Report, String> {
+        let (wall_s, steps, refused) = run_chunk(&mut self.sim, to_s, inflow)?;
+        let particles = read_back(&self.sim, cloud, self.frames.as_mut())?;
+        let parked = self.sim.parked_phase();
+        let points = particles
+            .as_ref()
+            .filter(|_| cloud)
+            .map(|p| cloud_points(&self.sim, p, parked));
+        self.report(wall_s, steps, refused, points)
+    }
+
+    fn observe(&mut self) -> Result<Observations, String> {
+        match &mut self.recorder {
+            Some(r) => r
+                .record(&self.sim, self.chunks)
+                .map_err(|e| format!("{e:#}")),
+            None => self
+                .sim
+                .observe()
+                .map_err(|e| format!("cannot read the observations back from the GPU: {e}")),
+        }
+    }
+
+    fn report(
+        &mut self,
+        wall_s: f64,
+        steps: u64,
+        refused_inflows: u64,
+        cloud: Option<Vec<CloudPoint>>,
+    ) -> Result<Report, String> {
+        Ok(Report {
+            obs: self.observe()?,
+            wall_s,
+            steps,
+            refused_inflows,
+            cloud,
+            reset: false,
+            frames_sent: self.frames.as_ref().map_or(0, |f| f.sent),
+            frames_skipped: self.frames.as_ref().map_or(0, |f| f.skipped),
+        })
     }
 }
 
