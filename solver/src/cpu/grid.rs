@@ -6,6 +6,7 @@
 
 use crate::gpu::params::SimParams;
 use crate::physics::lanes::{LANES, LaneMask};
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Particles of one row of cells that the vectorised passes take together.
@@ -79,7 +80,8 @@ impl Grid {
     pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32], parked: Option<u32>) -> Vec<u32> {
         let outside = self.starts.len() as u32 - 1;
         let cells: Vec<u32> = positions
-            .iter()
+            .par_iter()
+            .with_min_len(PAR_MIN)
             .map(|p| {
                 if Some(p[3].to_bits()) == parked {
                     outside
@@ -108,12 +110,20 @@ impl Grid {
             };
             order[slot as usize] = i as u32;
         }
-        for c in 0..self.starts.len() - 1 {
-            let cell = &mut order[self.starts[c] as usize..self.starts[c + 1] as usize];
+        // Each cell's slots apart, so the cells sort on any thread; the result is the same.
+        let mut cells: Vec<&mut [u32]> = Vec::new();
+        let mut rest = &mut order[..self.active() as usize];
+        for w in self.starts.windows(2) {
+            let (cell, after) = rest.split_at_mut((w[1] - w[0]) as usize);
             if cell.len() > 1 {
-                cell.sort_unstable_by_key(|&i| ids[i as usize]);
+                cells.push(cell);
             }
+            rest = after;
         }
+        cells
+            .into_par_iter()
+            .with_min_len(PAR_MIN / 8)
+            .for_each(|cell| cell.sort_unstable_by_key(|&i| ids[i as usize]));
         order
     }
 
@@ -204,5 +214,12 @@ impl Grid {
 
 /// `values` in sorted order: slot k holds the value of storage index `order[k]`.
 pub fn gather<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
-    order.iter().map(|&i| values[i as usize]).collect()
+    order
+        .par_iter()
+        .with_min_len(PAR_MIN)
+        .map(|&i| values[i as usize])
+        .collect()
 }
+
+/// Fewest particles a thread takes in the sort's parallel loops: less is not worth a wake-up.
+const PAR_MIN: usize = 4096;
