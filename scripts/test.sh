@@ -25,6 +25,11 @@ fi
 if ! python3 -c "import rerun" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check rerun-sdk==0.41.0
 fi
+# Foxglove's own WebSocket client and ROS 2 decoders, under Node, for the live view's test
+# (node/tests/foxglove.rs), at the versions the lock file pins.
+if command -v npm >/dev/null && [ ! -d tests/interop/foxglove_client/node_modules ]; then
+  npm ci --prefix tests/interop/foxglove_client --no-audit --no-fund --loglevel=error
+fi
 # cargo's output ends with the doc-test runs ("0 passed"): a last line sums the whole suite.
 log="$(mktemp)"
 status=0

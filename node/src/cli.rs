@@ -109,6 +109,10 @@ pub struct RunArgs {
     /// Offer no particle frames.
     #[arg(long)]
     pub no_frames: bool,
+    /// Serve the live view to Foxglove (its WebSocket protocol) on this port: every topic
+    /// with its ros2msg schema, the particles included (0: a free port, printed).
+    #[arg(long, value_name = "PORT")]
+    pub foxglove: Option<u16>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -1,8 +1,9 @@
 //! Where the twin meets the world: ROS 2 over DDS, iceoryx2 particle frames, MCAP bags, the
-//! files and terminal tables of the offline commands.
+//! Foxglove live view, the files and terminal tables of the offline commands.
 
 pub mod bag;
 pub mod files;
+pub mod foxglove;
 pub mod frames;
 pub mod progress;
 pub mod ros;

@@ -7,6 +7,7 @@
 
 use crate::adapters::bag::BagFile;
 use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
+use crate::adapters::foxglove::LiveView;
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::ros::parameters::{ParameterServices, ParameterStream, live_parameters};
 use crate::adapters::ros::services::{Call, Offered};
@@ -92,7 +93,8 @@ async fn serve(
     let use_sim_time = settings.use_sim_time;
     let sensors = Sensors::subscribe(&mut node, &full, &gauge_names, args.gauge_msg, use_sim_time)?;
     let mut tap = tap(args, &full, &gauge_names)?;
-    let outlets = Outlets::create(&mut node, &mut tap, &full, use_sim_time)?;
+    let view = LiveView::for_node(args, &full, &gauge_names).await?;
+    let outlets = Outlets::create(&mut node, &mut tap, &view, &full, use_sim_time)?;
     let node_path = format!("{}/{node_name}", namespace.trim_end_matches('/'));
     let servers = services(&mut node, &node_path)?;
     let parameters = ParameterServices::create(&mut node, &node_path)?;
@@ -126,6 +128,7 @@ async fn serve(
         parameters: &parameters,
         outlets,
         tap,
+        view,
         heard,
         fallback,
         reports: solver.reports,
@@ -135,6 +138,7 @@ async fn serve(
     // Closing the solver's channel: it finishes its chunk and stops.
     drop(twin);
     wire.tap.finish()?;
+    wire.view.stop().await;
     // Waiting for it is blocking work: off the async runtime's threads.
     let joined = tokio::task::spawn_blocking(move || solver.handle.join()).await;
     if !matches!(joined, Ok(Ok(()))) {
@@ -218,6 +222,7 @@ struct Wire<'a> {
     parameters: &'a ParameterServices,
     outlets: Outlets,
     tap: Tap,
+    view: LiveView,
     /// Set at the first sample a real sensor sends: a recorded session playing stops.
     heard: Arc<AtomicBool>,
     fallback: mpsc::Receiver<Sample>,
@@ -258,12 +263,14 @@ async fn drive(twin: &mut Twin, wire: &mut Wire<'_>) -> Result<()> {
                         println!("sensors heard on {topic}");
                     }
                     wire.tap.input(&sample);
+                    wire.view.input(&sample);
                     twin.sample(&topic, &sample);
                 }
                 Err(e) => twin.undecodable(&topic, &e),
             },
             Some(sample) = wire.fallback.recv() => {
                 wire.tap.input(&sample);
+                wire.view.input(&sample);
                 twin.sample_at(sample.input(), crate::twin::clock::system_s());
             }
             Some(report) = wire.reports.recv() => {
@@ -427,25 +434,22 @@ impl Outlets {
     fn create(
         node: &mut Node,
         tap: &mut Tap,
+        view: &LiveView,
         full: &dyn Fn(&str) -> String,
         use_sim_time: bool,
     ) -> Result<Outlets> {
+        use topics::{BED_MARKER, BED_PROFILE, CLOCK, DIAGNOSTICS, ERODED_MASS, PARTICLES};
+        use topics::{GAUGE_COMPARISON, LATCHED_QOS, OUTPUT_QOS, STREAM_QOS};
         Ok(Outlets {
-            bed: outlet(node, tap, full, topics::BED_PROFILE, topics::LATCHED_QOS)?,
-            eroded: outlet(node, tap, full, topics::ERODED_MASS, topics::OUTPUT_QOS)?,
-            compare: outlet(
-                node,
-                tap,
-                full,
-                topics::GAUGE_COMPARISON,
-                topics::OUTPUT_QOS,
-            )?,
+            bed: outlet(node, tap, view, full, BED_PROFILE, LATCHED_QOS)?,
+            eroded: outlet(node, tap, view, full, ERODED_MASS, OUTPUT_QOS)?,
+            compare: outlet(node, tap, view, full, GAUGE_COMPARISON, OUTPUT_QOS)?,
             clock: (!use_sim_time)
-                .then(|| outlet(node, tap, full, topics::CLOCK, topics::STREAM_QOS))
+                .then(|| outlet(node, tap, view, full, CLOCK, STREAM_QOS))
                 .transpose()?,
-            diagnostics: outlet(node, tap, full, topics::DIAGNOSTICS, topics::OUTPUT_QOS)?,
-            cloud: outlet(node, tap, full, topics::PARTICLES, topics::STREAM_QOS)?,
-            marker: outlet(node, tap, full, topics::BED_MARKER, topics::LATCHED_QOS)?,
+            diagnostics: outlet(node, tap, view, full, DIAGNOSTICS, OUTPUT_QOS)?,
+            cloud: outlet(node, tap, view, full, PARTICLES, STREAM_QOS)?,
+            marker: outlet(node, tap, view, full, BED_MARKER, LATCHED_QOS)?,
         })
     }
 

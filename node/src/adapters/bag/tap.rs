@@ -6,6 +6,7 @@
 
 use crate::adapters::bag::writer::{Channel, nanos};
 use crate::adapters::bag::{BagWriter, TopicQos};
+use crate::adapters::foxglove::LiveChannel;
 use crate::twin::samples::Sample;
 use anyhow::Result;
 use flume_msgs::RosMessage;
@@ -124,16 +125,21 @@ pub fn input_channels(
     Ok(out)
 }
 
-/// A publisher and, when the node records, its channel.
+/// A publisher and, when the node records, its channel; when it serves Foxglove, its live
+/// channel.
 pub struct Outlet<M: Serialize> {
     pub publisher: Publisher<M>,
     pub channel: Option<Channel>,
+    pub live: Option<LiveChannel>,
 }
 
 impl<M: Serialize + std::fmt::Debug> Outlet<M> {
-    /// Records `msg` and publishes it.
+    /// Records `msg`, shows it live and publishes it.
     pub async fn send(&self, tap: &mut Tap, msg: M) {
         tap.output(self.channel, &msg);
+        if let Some(live) = &self.live {
+            live.log(&msg);
+        }
         if let Err(e) = self.publisher.async_publish(msg).await {
             log::warn!("a message could not be published: {e:?}");
         }

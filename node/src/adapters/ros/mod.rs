@@ -8,6 +8,7 @@ pub mod services;
 
 use crate::adapters::bag::TopicQos;
 use crate::adapters::bag::tap::{Outlet, Tap};
+use crate::adapters::foxglove::LiveView;
 use anyhow::{Context as _, Result, anyhow};
 use args::RosArgs;
 use flume_msgs::{MsgDef, RosMessage};
@@ -55,10 +56,12 @@ pub fn full_topic(namespace: &str, ros: &RosArgs, name: &str) -> String {
     }
 }
 
-/// A publisher of `M` on `name`, recorded when the node records.
+/// A publisher of `M` on `name`, recorded when the node records, shown when it serves
+/// Foxglove.
 pub fn outlet<M: RosMessage + Serialize>(
     node: &mut Node,
     recorder: &mut Tap,
+    view: &LiveView,
     full: &dyn Fn(&str) -> String,
     name: &str,
     topic_qos: TopicQos,
@@ -72,6 +75,7 @@ pub fn outlet<M: RosMessage + Serialize>(
             .create_publisher::<M>(&topic, Some(q))
             .with_context(|| format!("cannot publish {name}"))?,
         channel: recorder.channel::<M>(&full(name), topic_qos)?,
+        live: view.channel::<M>(&full(name))?,
     })
 }
 
