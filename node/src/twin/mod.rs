@@ -40,6 +40,12 @@ pub fn gauge_names(case: &flume_solver::Case) -> Vec<String> {
         .collect()
 }
 
+/// How close to `--until` the twin counts as there: 1 us, less than any step. Driven by
+/// sensors, a chunk ends at the newest sample's stamp (ns since the epoch, less the origin),
+/// which can leave the twin a fraction of a microsecond short; a chunk for that fraction would
+/// publish its outputs a second time at what reads as the same stamp.
+const UNTIL_TOLERANCE_S: f64 = 1e-6;
+
 /// What a live twin keeps for the whole run (the settings that may change live are apart).
 #[derive(Debug, Clone)]
 pub struct Options {
@@ -254,7 +260,7 @@ impl Twin {
         let Some(chunk) = self
             .pacer
             .next_chunk(self.sim_t, now, cap)
-            .filter(|_| cap > 0.0)
+            .filter(|_| cap > UNTIL_TOLERANCE_S)
         else {
             return Ok(());
         };
@@ -289,7 +295,10 @@ impl Twin {
         let due = self
             .last_publish
             .is_none_or(|t| t.elapsed().as_secs_f64() >= 1.0 / self.settings.publish_rate_hz);
-        let last = self.options.until.is_some_and(|u| self.sim_t >= u);
+        let last = self
+            .options
+            .until
+            .is_some_and(|u| self.sim_t >= u - UNTIL_TOLERANCE_S);
         let outputs = if due || last {
             self.last_publish = Some(Instant::now());
             self.counters.published_outputs += 1;
