@@ -13,6 +13,10 @@ fi
 if ! python3 -c "import mcap_ros2" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check mcap mcap-ros2-support
 fi
+# rosbags, a rosbag2 reader, for our bag directories (node/tests/record.rs).
+if ! python3 -c "import rosbags" >/dev/null 2>&1; then
+  python3 -m pip install --quiet --disable-pip-version-check rosbags==0.11.9
+fi
 # A DDS nobody here wrote, for the ROS 2 interop test (node/tests/ros_interop.rs).
 if ! python3 -c "import cyclonedds" >/dev/null 2>&1; then
   python3 -m pip install --quiet --disable-pip-version-check cyclonedds

@@ -83,8 +83,9 @@ pub struct RunArgs {
     /// Stop once simulated time reaches this, s (scripted runs and tests).
     #[arg(long, value_name = "T_S", value_parser = positive)]
     pub until: Option<f64>,
-    /// Record every input and output topic to this MCAP file (rosbag2's conventions).
-    #[arg(long, value_name = "FILE")]
+    /// Record every input and output topic to this rosbag2 bag directory (metadata.yaml and
+    /// BAG_0.mcap), or to this file alone if it ends in .mcap.
+    #[arg(long, value_name = "BAG")]
     pub record: Option<PathBuf>,
     /// With no sensor heard in --silent-wait-s, this recording's inflow and gauge topics play
     /// the sensors (the path is relative to the working directory, the repository's root).
@@ -187,7 +188,8 @@ pub struct SweepArgs {
 
 #[derive(Debug, Args)]
 pub struct ReplayArgs {
-    /// The recording (MCAP) whose inflow and gauge topics drive the twin.
+    /// The recording (a bag directory or an MCAP file) whose inflow and gauge topics drive
+    /// the twin.
     pub recording: PathBuf,
     /// Case file (YAML) with an open flume, e.g. launch_configs/ulbra_flume.yaml.
     #[arg(
@@ -201,10 +203,12 @@ pub struct ReplayArgs {
     /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
     #[arg(long = "set", value_name = "KEY=VALUE", conflicts_with = "publish")]
     pub set: Vec<String>,
-    /// Write the replayed inputs and the twin's outputs to this recording (MCAP).
-    #[arg(long, value_name = "FILE", conflicts_with = "publish")]
+    /// Write the replayed inputs and the twin's outputs to this recording (a bag directory,
+    /// or a file if it ends in .mcap).
+    #[arg(long, value_name = "BAG", conflicts_with = "publish")]
     pub out: Option<PathBuf>,
-    /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk.
+    /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk, and
+    /// at the end gauges.png (predicted against measured levels) and eroded_mass.png.
     #[arg(long, value_name = "DIR", conflicts_with = "publish")]
     pub csv: Option<PathBuf>,
     /// Pace the replay at this many recorded seconds per wall second, 0.001 to 1000 [default:
@@ -265,8 +269,8 @@ pub struct MakeSessionArgs {
     /// in the key indexes a list: `phases.1.sediment.ks_over_d50=7`).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// The recording to write.
-    #[arg(long, value_name = "FILE")]
+    /// The recording to write (a bag directory, or a file if it ends in .mcap).
+    #[arg(long, value_name = "BAG")]
     pub out: PathBuf,
     /// Length of the session, s.
     #[arg(long, value_name = "S", default_value_t = 75.0, value_parser = positive)]

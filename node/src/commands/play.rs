@@ -1,4 +1,4 @@
-//! `flume-twin replay REC.mcap --publish`: a recorded session's sensor topics played on the
+//! `flume-twin replay REC --publish`: a recorded session's sensor topics played on the
 //! wire (ROS 2 over DDS) with `/clock`, as `ros2 bag play --clock` does, for a twin (or any
 //! ROS node) running on simulated time (`use_sim_time:=true`) elsewhere.
 //!

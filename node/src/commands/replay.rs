@@ -1,4 +1,4 @@
-//! `flume-twin replay REC.mcap --config CASE --out OUT.mcap`: a recorded session's sensor
+//! `flume-twin replay REC --config CASE --out OUT`: a recorded session's sensor
 //! topics fed to the twin in-process, no DDS. Simulated time 0 is the first replayed sample's
 //! stamp; the solver runs in lock-step chunks ending on a fixed grid of `--output-interval-s`,
 //! each discharge applied at its own stamp, so the same recording on the same adapter gives
@@ -9,6 +9,7 @@
 
 use crate::adapters::bag::writer::Channel as BagChannel;
 use crate::adapters::bag::{BagFile, BagMessage, BagWriter};
+use crate::adapters::files::series_plot::SeriesPlots;
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::topics;
 use crate::cli::ReplayArgs;
@@ -127,6 +128,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         args.recording.display(),
         feed.end
     );
+    let case_name = case.name.clone();
     let solver = solver_thread::spawn(case, args.csv.clone(), None)?;
     println!(
         "adapter: {}\nparticles: {}",
@@ -152,9 +154,15 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         twin.sample_at(input, feed.messages[k].0.log_ns as f64 * 1e-9);
     }
     let mut out = args.out.as_deref().map(OutputBag::create).transpose()?;
+    // The plots go beside the CSV files they draw.
+    let mut plots = args.csv.as_ref().map(|_| SeriesPlots::compared());
     let mut reports = solver.reports;
     let started = Instant::now();
-    let ran = lock_step(args, &mut twin, &feed, &mut reports, out.as_mut())?;
+    let sinks = Sinks {
+        bag: out.as_mut(),
+        plots: plots.as_mut(),
+    };
+    let ran = lock_step(args, &mut twin, &feed, &mut reports, sinks)?;
     let refused: Vec<String> = twin
         .refused()
         .iter()
@@ -173,6 +181,11 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         let path = out.bag.path().to_path_buf();
         out.bag.finish()?;
         println!("wrote {}", path.display());
+    }
+    if let (Some(plots), Some(dir)) = (&plots, &args.csv) {
+        for path in plots.draw(dir, &case_name)? {
+            println!("plot: {}", path.display());
+        }
     }
     let t = ran.t;
     println!(
@@ -279,6 +292,12 @@ struct Ran {
     inputs_written: usize,
 }
 
+/// Where a replay's outputs go besides the CSV files: the output recording, the plots.
+struct Sinks<'a> {
+    bag: Option<&'a mut OutputBag>,
+    plots: Option<&'a mut SeriesPlots>,
+}
+
 /// Runs the twin in chunks ending on the grid of `--output-interval-s` (paced by `--rate`
 /// when given), writing the inputs of each chunk and the twin's outputs at its end.
 fn lock_step(
@@ -286,14 +305,21 @@ fn lock_step(
     twin: &mut Twin,
     feed: &Feed,
     reports: &mut mpsc::UnboundedReceiver<Result<Report, String>>,
-    mut out: Option<&mut OutputBag>,
+    sinks: Sinks,
 ) -> Result<Ran> {
-    if let Some(out) = out.as_mut() {
+    let Sinks {
+        bag: mut out,
+        mut plots,
+    } = sinks;
+    if out.is_some() || plots.is_some() {
         let outputs = twin.outputs_now(feed.origin);
-        out.observation(
-            &outputs,
-            Time::from_secs_f64(feed.origin).unwrap_or_default(),
-        )?;
+        if let Some(plots) = plots.as_mut() {
+            plots.compare(0.0, &outputs.comparison, outputs.eroded.as_ref());
+        }
+        if let Some(out) = out.as_mut() {
+            let stamp = Time::from_secs_f64(feed.origin).unwrap_or_default();
+            out.observation(&outputs, stamp)?;
+        }
     }
     let started = Instant::now();
     let mut ran = Ran {
@@ -319,6 +345,9 @@ fn lock_step(
         ran.steps += report.steps;
         let outputs = twin.report_at(report, feed.origin + to);
         ran.t = twin.sim_t();
+        if let Some(plots) = plots.as_mut() {
+            plots.compare(to, &outputs.comparison, outputs.eroded.as_ref());
+        }
         let Some(out) = out.as_mut() else { continue };
         while let Some(&(k, _)) = feed.events.get(ran.inputs_written) {
             let m = feed.messages[k].0;

@@ -1,7 +1,7 @@
 //! `flume-twin simulate`: an offline run of a case, interval by interval.
 
 use crate::adapters::files::inflow::InflowSeries;
-use crate::adapters::files::{bed_plot, outputs::OutputFiles};
+use crate::adapters::files::{bed_plot, outputs::OutputFiles, series_plot::SeriesPlots};
 use crate::adapters::progress;
 use crate::adapters::table::{Table, sci, sig};
 use crate::cli::SimulateArgs;
@@ -72,6 +72,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     bar.set_message(format!("t = 0/{end_s} s"));
     let started = Instant::now();
     let mut last = recorder.record(&sim, 0)?;
+    let mut plots = SeriesPlots::predicted_only();
+    plots.observe(&last);
     let initial_profile = last.profile.clone();
     let mut bed_profiles = Vec::new();
     for k in 1..=intervals {
@@ -94,6 +96,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
         let before_s = last.time_s;
         last = recorder.record(&sim, k)?;
+        plots.observe(&last);
         if passes_a_quarter(before_s, last.time_s, end_s) {
             bed_profiles.push((last.time_s, last.profile.clone()));
         }
@@ -111,6 +114,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let path = out_dir.join("bed.png");
         bed_plot::draw(&path, &case.name, &initial_profile, &bed_profiles)?;
         println!("bed plot: {}", path.display());
+    }
+    for path in plots.draw(&out_dir, &case.name)? {
+        println!("plot: {}", path.display());
     }
     print_summary(&sim, &last, wall_s);
     Ok(())

@@ -1,9 +1,11 @@
-//! Recordings: MCAP files with rosbag2's conventions (profile `ros2`, `ros2msg` schemas holding
-//! the full concatenated definition, `cdr` messages, each channel's offered QoS), so that
-//! `ros2 bag`, Foxglove and rerun open what the twin records, and the twin replays what they
-//! record.
+//! Recordings: rosbag2 bag directories or bare MCAP files, with rosbag2's conventions (profile
+//! `ros2`, `ros2msg` schemas holding the full concatenated definition, `cdr` messages, each
+//! channel's offered QoS), so that `ros2 bag`, `rosbags`, Foxglove and rerun open what the
+//! twin records, and the twin replays what they record.
 
+pub mod directory;
 pub mod reader;
+mod tail;
 pub mod tap;
 pub mod writer;
 
@@ -26,6 +28,12 @@ mod tests {
 
     /// Ten chunks of ten levels each.
     fn write(path: &std::path::Path) {
+        let bag = write_unfinished(path);
+        bag.finish().expect("finishes");
+    }
+
+    /// Ten chunks of ten levels each, flushed and not finished.
+    fn write_unfinished(path: &std::path::Path) -> BagWriter {
         let mut bag = BagWriter::create(path, None).expect("creates");
         let ch = bag
             .channel::<WaterLevel>("/gauges/p1", QOS)
@@ -43,7 +51,7 @@ mod tests {
                 bag.flush().expect("flushes");
             }
         }
-        bag.finish().expect("finishes");
+        bag
     }
 
     fn levels(r: &BagFile) -> Vec<f64> {
@@ -124,5 +132,109 @@ mod tests {
         for p in [path, cut, bad, junk] {
             std::fs::remove_file(p).ok();
         }
+    }
+
+    /// A bag directory's metadata.yaml as YAML.
+    fn metadata(dir: &std::path::Path) -> serde_norway::Value {
+        let text = std::fs::read_to_string(dir.join("metadata.yaml")).expect("metadata.yaml");
+        let doc: serde_norway::Value = serde_norway::from_str(&text).expect("YAML");
+        doc["rosbag2_bagfile_information"].clone()
+    }
+
+    #[test]
+    fn a_bag_directory_holds_its_file_and_metadata_counting_each_topic() {
+        let dir = temp("bag");
+        write(&dir);
+        let r = BagFile::read(&dir).expect("reads");
+        assert_eq!(r.damage, None);
+        assert_eq!(
+            levels(&r),
+            (0..100).map(|k| k as f64 * 1e-3).collect::<Vec<_>>()
+        );
+        let name = format!("flume-bag-{}-bag_0.mcap", std::process::id());
+        assert!(dir.join(&name).is_file());
+        let m = metadata(&dir);
+        assert_eq!(m["version"], 9);
+        assert_eq!(m["storage_identifier"], "mcap");
+        assert_eq!(m["relative_file_paths"][0].as_str(), Some(name.as_str()));
+        assert_eq!(m["files"][0]["path"].as_str(), Some(name.as_str()));
+        assert_eq!(m["message_count"], 100);
+        assert_eq!(m["starting_time"]["nanoseconds_since_epoch"], 0);
+        assert_eq!(m["duration"]["nanoseconds"], 99_000_000_000u64);
+        let topic = &m["topics_with_message_count"][0];
+        assert_eq!(topic["message_count"], 100);
+        assert_eq!(topic["topic_metadata"]["name"], "/gauges/p1");
+        assert_eq!(topic["topic_metadata"]["type"], "flume_msgs/msg/WaterLevel");
+        assert_eq!(topic["topic_metadata"]["serialization_format"], "cdr");
+        let qos = &topic["topic_metadata"]["offered_qos_profiles"][0];
+        assert_eq!(
+            (&qos["reliability"], &qos["depth"]),
+            (&"best_effort".into(), &5.into())
+        );
+        // rosbag2 records into a new directory only.
+        let err = BagWriter::create(&dir, None).err().expect("refused");
+        assert!(err.to_string().contains("is not empty"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_recording_never_finished_reads_to_its_last_flush_with_metadata_to_match() {
+        let dir = temp("killed");
+        let mut bag = write_unfinished(&dir);
+        // Written after the last flush, then the process dies: neither reaches the disk.
+        let ch = bag
+            .channel::<WaterLevel>("/gauges/p2", QOS)
+            .expect("channel");
+        bag.write(ch, &WaterLevel::default(), 0, 0).expect("writes");
+        std::mem::forget(bag);
+        let file = dir.join(format!("flume-bag-{}-killed_0.mcap", std::process::id()));
+        let bytes = std::fs::read(&file).expect("reads");
+        assert!(bytes.ends_with(mcap::MAGIC), "a provisional end");
+        let r = BagFile::read(&dir).expect("reads");
+        assert_eq!(r.damage, None);
+        assert_eq!(
+            levels(&r),
+            (0..100).map(|k| k as f64 * 1e-3).collect::<Vec<_>>()
+        );
+        let m = metadata(&dir);
+        assert_eq!(m["message_count"], 100);
+        assert_eq!(
+            m["topics_with_message_count"].as_sequence().map(Vec::len),
+            Some(1)
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_directory_that_is_no_bag_is_refused_with_the_reason() {
+        let dir = temp("bad");
+        std::fs::create_dir_all(&dir).expect("creates");
+        let err = BagFile::read(&dir).expect_err("empty");
+        assert!(
+            err.to_string()
+                .contains("holds no metadata.yaml and no .mcap"),
+            "{err}"
+        );
+        let yaml = dir.join("metadata.yaml");
+        std::fs::write(&yaml, "rosbag2_bagfile_information: [not, a, map").expect("writes");
+        let err = format!("{:#}", BagFile::read(&dir).expect_err("corrupt"));
+        assert!(err.contains("is not rosbag2 metadata"), "{err}");
+        std::fs::write(
+            &yaml,
+            "rosbag2_bagfile_information:\n  storage_identifier: mcap\n  \
+             relative_file_paths: [gone_0.mcap]\n",
+        )
+        .expect("writes");
+        let err = BagFile::read(&dir).expect_err("missing file");
+        assert!(err.to_string().contains("which is not there"), "{err}");
+        std::fs::write(
+            &yaml,
+            "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  \
+             relative_file_paths: [bag_0.db3]\n",
+        )
+        .expect("writes");
+        let err = BagFile::read(&dir).expect_err("sqlite3");
+        assert!(err.to_string().contains("only MCAP bags"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -1,6 +1,7 @@
 //! Reads a recording, or as much of one as is sound: a file cut short by a crash, or damaged
 //! on the way, gives every message up to the damage and a sentence saying where it stopped.
 
+use crate::adapters::bag::directory::recordings_in;
 use anyhow::{Context, Result, bail};
 use serde::de::DeserializeOwned;
 use std::path::Path;
@@ -38,9 +39,30 @@ pub struct BagFile {
 }
 
 impl BagFile {
-    /// Reads `path`. A file that is not an MCAP recording at all is an error; one damaged
+    /// Reads `path`: a bag directory (each MCAP file its metadata lists, or the one inside)
+    /// or an MCAP file. A file that is not an MCAP recording at all is an error; one damaged
     /// part way is not: its readable part comes back with `damage` saying what stopped it.
     pub fn read(path: &Path) -> Result<BagFile> {
+        if !path.is_dir() {
+            return BagFile::read_file(path);
+        }
+        let mut bag = BagFile {
+            messages: Vec::new(),
+            damage: None,
+        };
+        for file in recordings_in(path)? {
+            let part = BagFile::read_file(&file)?;
+            bag.messages.extend(part.messages);
+            // A split bag's later files follow the damage: none of them is read.
+            if part.damage.is_some() {
+                bag.damage = part.damage;
+                break;
+            }
+        }
+        Ok(bag)
+    }
+
+    fn read_file(path: &Path) -> Result<BagFile> {
         let bytes = std::fs::read(path)
             .with_context(|| format!("cannot read the recording {}", path.display()))?;
         if !bytes.starts_with(mcap::MAGIC) {

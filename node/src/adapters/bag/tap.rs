@@ -1,8 +1,8 @@
-//! The node's own recording (`run --record FILE`): every sample that came in and every message
-//! that went out, as it happened (log time = the node's clock when it was taken or sent), with
-//! rosbag2's conventions. Chunks close each second, so `kill -9` loses at most the last second;
-//! SIGINT and SIGTERM finish the file. A recording that cannot be written is stopped with an
-//! error line; the twin runs on.
+//! The node's own recording (`run --record BAG`, a bag directory or a FILE.mcap): every sample
+//! that came in and every message that went out, as it happened (log time = the node's clock
+//! when it was taken or sent), with rosbag2's conventions. Chunks close each second, so
+//! `kill -9` loses at most the last second; SIGINT and SIGTERM finish the file. A recording
+//! that cannot be written is stopped with an error line; the twin runs on.
 
 use crate::adapters::bag::writer::{Channel, nanos};
 use crate::adapters::bag::{BagWriter, TopicQos};

@@ -1,18 +1,22 @@
-//! Writes a recording as rosbag2's MCAP storage plugin does.
+//! Writes a recording as rosbag2's MCAP storage plugin does: to a bag directory
+//! (`directory.rs`) or, for a path ending in `.mcap`, to that file alone.
 //!
 //! Chunks are LZ4-compressed and close at 768 KiB (rosbag2's chunk size) or, when the writer
 //! is asked to, at a flush every so often: a chunk is the unit a crash can lose, so a live
 //! recording flushes each second and a `kill -9` costs at most the last second. LZ4 rather
 //! than zstd because the writer shares the machine with the solver: it compresses at several
 //! hundred MB/s per core, and the bed profiles and gauge series it sees are small and regular
-//! enough that zstd's better ratio would buy little.
+//! enough that zstd's better ratio would buy little. After each flush the file ends as a
+//! finished MCAP without a summary does (`tail.rs`), so that readers which start from the end
+//! open a killed recording too.
 
+use crate::adapters::bag::directory::{BagMetadata, is_bare_file};
+use crate::adapters::bag::tail::Tail;
 use anyhow::{Context, Result};
 use flume_msgs::RosMessage;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -57,32 +61,46 @@ impl TopicQos {
 pub struct Channel(u16);
 
 pub struct BagWriter {
+    /// The bag directory or the bare file.
     path: PathBuf,
-    mcap: mcap::Writer<BufWriter<File>>,
+    mcap: mcap::Writer<Tail>,
+    /// A bag directory's metadata; none for a bare file.
+    metadata: Option<BagMetadata>,
     sequence: u32,
     flush_every: Option<Duration>,
     last_flush: Instant,
 }
 
 impl BagWriter {
-    /// Creates `path`; with `flush_every`, a chunk closes at least that often.
+    /// Creates the bag directory `path`, or the file `path` if it ends in `.mcap`; with
+    /// `flush_every`, a chunk closes at least that often.
     pub fn create(path: &Path, flush_every: Option<Duration>) -> Result<BagWriter> {
-        let file =
-            File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+        let (metadata, file_path) = if is_bare_file(path) {
+            (None, path.to_path_buf())
+        } else {
+            let (metadata, file) = BagMetadata::create(path)?;
+            (Some(metadata), file)
+        };
+        let file = File::create(&file_path)
+            .with_context(|| format!("cannot create {}", file_path.display()))?;
         let mcap = mcap::WriteOptions::new()
             .profile("ros2")
             .library(concat!("flume-twin ", env!("CARGO_PKG_VERSION")))
             .compression(Some(mcap::Compression::Lz4))
             .chunk_size(Some(CHUNK_BYTES))
-            .create(BufWriter::new(file))
+            .create(Tail::new(file))
             .with_context(|| format!("cannot start the recording {}", path.display()))?;
-        Ok(BagWriter {
+        let mut writer = BagWriter {
             path: path.to_path_buf(),
             mcap,
+            metadata,
             sequence: 0,
             flush_every,
             last_flush: Instant::now(),
-        })
+        };
+        // From the start the file is an MCAP that readers open, if an empty one.
+        writer.flush()?;
+        Ok(writer)
     }
 
     pub fn path(&self) -> &Path {
@@ -119,6 +137,9 @@ impl BagWriter {
             .mcap
             .add_channel(schema, topic, "cdr", &metadata)
             .with_context(|| format!("cannot add channel {topic}"))?;
+        if let Some(m) = self.metadata.as_mut() {
+            m.add_channel(id, topic, schema_name, offered_qos_profiles);
+        }
         Ok(Channel(id))
     }
 
@@ -154,6 +175,9 @@ impl BagWriter {
         self.mcap
             .write_to_known_channel(&header, data)
             .with_context(|| format!("cannot write to {}", self.path.display()))?;
+        if let Some(m) = self.metadata.as_mut() {
+            m.count(channel.0, log_ns);
+        }
         if self
             .flush_every
             .is_some_and(|every| self.last_flush.elapsed() >= every)
@@ -164,20 +188,26 @@ impl BagWriter {
     }
 
     /// Closes the open chunk and hands it to the operating system: what a crash cannot take.
+    /// A bag directory's metadata then counts what the file holds.
     pub fn flush(&mut self) -> Result<()> {
         self.last_flush = Instant::now();
         self.mcap
             .flush()
-            .with_context(|| format!("cannot flush {}", self.path.display()))
+            .with_context(|| format!("cannot flush {}", self.path.display()))?;
+        self.metadata.as_ref().map_or(Ok(()), BagMetadata::write)
     }
 
-    /// Writes the summary and the footer; without them a reader still gets every flushed
-    /// chunk.
+    /// Writes the summary and the footer, and a bag directory's metadata; without them a
+    /// reader still gets every flushed chunk.
     pub fn finish(mut self) -> Result<()> {
         self.mcap
             .finish()
             .with_context(|| format!("cannot finish {}", self.path.display()))?;
-        Ok(())
+        self.mcap
+            .into_inner()
+            .close()
+            .with_context(|| format!("cannot finish {}", self.path.display()))?;
+        self.metadata.as_ref().map_or(Ok(()), BagMetadata::write)
     }
 }
 
