@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{ULBRA_CI, gpu, printed, python_has, read_mcap, repo_file, ulbra_twin};
+use common::{ULBRA_CI, gpu, interop_json, printed, python_has, read_mcap, repo_file, ulbra_twin};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -68,18 +68,7 @@ fn full(topic: &str) -> String {
 /// The bag directory `dir` as `rosbags` reads it (`tests/interop/read_rosbag.py`), with the
 /// messages of `topics` decoded.
 fn read_rosbag(dir: &Path, topics: &[String]) -> Value {
-    let out = Command::new("python3")
-        .arg(repo_file("tests/interop/read_rosbag.py"))
-        .arg(dir)
-        .args(topics)
-        .output()
-        .expect("runs python3");
-    assert!(
-        out.status.success(),
-        "read_rosbag.py failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+    interop_json("read_rosbag.py", dir, topics)
 }
 
 /// The bag's MCAP file.

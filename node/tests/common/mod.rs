@@ -104,15 +104,24 @@ pub fn ulbra_twin() -> std::process::Command {
 /// A recording as Python's `mcap` and `mcap-ros2-support` read it
 /// (`tests/interop/read_mcap.py`), with the messages of `topics` decoded.
 pub fn read_mcap<S: AsRef<std::ffi::OsStr>>(path: &Path, topics: &[S]) -> serde_json::Value {
+    interop_json("read_mcap.py", path, topics)
+}
+
+/// What an independent reader (`tests/interop/SCRIPT PATH ARGS...`) printed as JSON.
+pub fn interop_json<S: AsRef<std::ffi::OsStr>>(
+    script: &str,
+    path: &Path,
+    args: &[S],
+) -> serde_json::Value {
     let out = std::process::Command::new("python3")
-        .arg(repo_file("tests/interop/read_mcap.py"))
+        .arg(repo_file(&format!("tests/interop/{script}")))
         .arg(path)
-        .args(topics)
+        .args(args)
         .output()
         .expect("runs python3");
     assert!(
         out.status.success(),
-        "read_mcap.py failed: {}",
+        "{script} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("JSON")

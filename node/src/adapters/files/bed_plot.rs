@@ -2,7 +2,8 @@
 //! Zw) along the flume at a few times, one panel each, against the initial bed surface, as the
 //! paper's Figs. 13-16 show them; a researcher sees the scour at a glance.
 
-use anyhow::{Context, Result, anyhow};
+use super::draw_png;
+use anyhow::{Result, anyhow};
 use flume_solver::ProfileColumn;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
@@ -120,7 +121,7 @@ pub fn draw(
     let margin = (0.1 * (z_hi - z_lo)).max(0.005);
     let y = (z_lo - margin)..(z_hi + margin);
     let text = font_registered();
-    let drawn = (|| -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    draw_png(path, || {
         let height = PANEL_HEIGHT * panels.len() as u32;
         let root = BitMapBackend::new(path, (1200, height)).into_drawing_area();
         root.fill(&WHITE)?;
@@ -166,10 +167,7 @@ pub fn draw(
         }
         root.present()?;
         Ok(())
-    })();
-    drawn
-        .map_err(|e| anyhow!("{e}"))
-        .with_context(|| format!("cannot draw {}", path.display()))
+    })
 }
 
 #[cfg(test)]

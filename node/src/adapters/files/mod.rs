@@ -9,3 +9,14 @@ pub mod outputs;
 pub mod series_plot;
 pub mod sweep_plot;
 pub mod vtk;
+
+/// What plotters' drawing calls give back.
+pub type Drawn = Result<(), Box<dyn std::error::Error + Send + Sync>>;
+
+/// Draws a picture into `path` with `draw`; plotters' error is said with the file's name.
+pub fn draw_png(path: &std::path::Path, draw: impl FnOnce() -> Drawn) -> anyhow::Result<()> {
+    use anyhow::Context as _;
+    draw()
+        .map_err(|e| anyhow::anyhow!("{e}"))
+        .with_context(|| format!("cannot draw {}", path.display()))
+}

@@ -5,7 +5,8 @@
 //! `simulate` has no measurements: its gauge panels show the prediction alone and say so.
 
 use super::bed_plot::font_registered;
-use anyhow::{Context, Result, anyhow};
+use super::{Drawn, draw_png};
+use anyhow::Result;
 use flume_msgs::flume_msgs::{ErodedMass, GaugeComparison};
 use flume_solver::Observations;
 use plotters::coord::Shift;
@@ -27,7 +28,6 @@ const GAUGE_COLOURS: [RGBColor; 4] = [
     RGBColor(200, 160, 0),
 ];
 
-type Drawn = Result<(), Box<dyn std::error::Error + Send + Sync>>;
 type Chart<'a, 'b> =
     ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
@@ -130,7 +130,7 @@ impl SeriesPlots {
             .fold(0.0, f64::max);
         let panels = self.gauges.len() + usize::from(self.measured);
         let text = font_registered();
-        let drawn = (|| -> Drawn {
+        draw_png(path, || {
             let height = PANEL_HEIGHT * panels as u32;
             let root = BitMapBackend::new(path, (WIDTH, height)).into_drawing_area();
             root.fill(&WHITE)?;
@@ -156,10 +156,7 @@ impl SeriesPlots {
             }
             root.present()?;
             Ok(())
-        })();
-        drawn
-            .map_err(|e| anyhow!("{e}"))
-            .with_context(|| format!("cannot draw {}", path.display()))
+        })
     }
 }
 
@@ -307,7 +304,7 @@ fn draw_eroded(path: &Path, case_name: &str, eroded: &[(f64, f64)]) -> Result<()
     let y = 0.0..(1.1 * top).max(1e-3);
     let last = eroded.last().map_or(0.0, |e| e.1);
     let text = font_registered();
-    let drawn = (|| -> Drawn {
+    draw_png(path, || {
         let root = BitMapBackend::new(path, (WIDTH, 2 * PANEL_HEIGHT)).into_drawing_area();
         root.fill(&WHITE)?;
         let caption = format!("{case_name}: eroded sediment, {last:.4} kg/m at {t_end:.1} s");
@@ -323,10 +320,7 @@ fn draw_eroded(path: &Path, case_name: &str, eroded: &[(f64, f64)]) -> Result<()
         legend(&mut chart, text)?;
         root.present()?;
         Ok(())
-    })();
-    drawn
-        .map_err(|e| anyhow!("{e}"))
-        .with_context(|| format!("cannot draw {}", path.display()))
+    })
 }
 
 #[cfg(test)]

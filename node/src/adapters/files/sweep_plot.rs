@@ -3,8 +3,9 @@
 //! 3, 5, 7, 10 of the paper's Figure 10 are not).
 
 use super::bed_plot::font_registered;
+use super::draw_png;
 use crate::adapters::table::sig;
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
@@ -43,7 +44,7 @@ pub fn draw(path: &Path, title: &str, key: &str, bars: &[(String, Option<f64>)])
     // axis, with its zero-height bars labelled 0.
     let y_hi = if top > 0.0 { 1.15 * top } else { 1.0 };
     let text = font_registered();
-    let drawn = (|| -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    draw_png(path, || {
         let root = BitMapBackend::new(path, SIZE).into_drawing_area();
         root.fill(&WHITE)?;
         let mut builder = ChartBuilder::on(&root);
@@ -90,10 +91,7 @@ pub fn draw(path: &Path, title: &str, key: &str, bars: &[(String, Option<f64>)])
         }
         root.present()?;
         Ok(())
-    })();
-    drawn
-        .map_err(|e| anyhow!("{e}"))
-        .with_context(|| format!("cannot draw {}", path.display()))
+    })
 }
 
 #[cfg(test)]
