@@ -444,3 +444,48 @@ fn the_launch_file_and_rviz_config_are_well_formed() {
         serde_norway::Value::from("flume")
     );
 }
+
+/// A normal start prints the twin's own lines and nothing to alarm a user: no ERROR (RustDDS
+/// once reported a /clock type clash with ros2-client's spinner at each start), no warning
+/// that asks nothing of them (`ROS_DISTRO` unset, iceoryx2 on its defaults), and nothing from
+/// Mesa when `XDG_RUNTIME_DIR` is unset, as under a service manager. Both streams are read in
+/// order, up to the twin reaching --until; what RustDDS says at exit on loopback is apart.
+#[test]
+fn a_normal_start_prints_nothing_alarming() {
+    let out = Command::new("sh")
+        .args([
+            "-c",
+            "exec \"$0\" \"$@\" 2>&1",
+            env!("CARGO_BIN_EXE_flume-twin"),
+        ])
+        .arg("run")
+        .arg(repo_file("solver/tests/cases/recycle_2d.yaml"))
+        .args(["--loopback", "--no-replay", "--until", "0.3"])
+        .args(["--ros-args", "-r", "__ns:=/flume_quiet"])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("RUST_LOG")
+        .env_remove("ROS_DISTRO")
+        .output()
+        .expect("runs the twin");
+    let said = text(&out.stdout);
+    assert!(out.status.success(), "{said}");
+    assert!(said.contains("reached t = 0.300 s"), "{said}");
+    let start = said
+        .split("reached t = ")
+        .next()
+        .expect("the output up to --until");
+    for expected in [
+        "adapter: ",
+        "particles: ",
+        "node: /flume_quiet flume_twin",
+        "listening: ",
+    ] {
+        assert!(start.contains(expected), "no {expected:?} in:\n{said}");
+    }
+    for line in start.lines() {
+        let alarming = ["ERROR", "WARN", "error", "[W]", "XDG_RUNTIME_DIR"]
+            .iter()
+            .any(|a| line.contains(a));
+        assert!(!alarming, "{line:?} at start:\n{said}");
+    }
+}
