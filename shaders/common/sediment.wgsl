@@ -47,8 +47,8 @@ fn log_profile(regime: u32, z: f32, u_star: f32, ks: f32, nu: f32) -> f32 {
 }
 
 // Friction velocity u* such that the profile of Eqs. 19-21 passes through speed u at height z
-// above the bed: the viscous sub-layer first, then the log law regime by regime, bisecting
-// within the regime whose u* range brackets the solution (see `friction_velocity` in
+// above the bed: the viscous sub-layer first, then the log law regime by regime, narrowing
+// the bracket of the regime whose u* range holds the solution (see `friction_velocity` in
 // shields.rs, whose bracket and stopping rules this follows step for step).
 fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> f32 {
     if (!(u > 0.0) || !(z > 0.0) || u > HUGE) {
@@ -90,22 +90,48 @@ fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> f32 {
         if (log_profile(regime, z, hi, ks, nu) < u) {
             continue;
         }
-        var iterations = 0u;
-        while (hi - lo > BISECTION_REL_TOL * hi) {
-            let mid = 0.5 * (lo + hi);
-            if (mid <= lo || mid >= hi || iterations == FRICTION_VELOCITY_MAX_ITERATIONS) {
-                break;
-            }
-            iterations++;
-            if (log_profile(regime, z, mid, ks, nu) >= u) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        return hi;
+        return narrow_bracket(regime, u, z, ks, nu, lo, hi);
     }
     return sublayer_top;
+}
+
+// d u / d u* of the log law of `regime` (smooth or transitional), `profile_slope` in shields.rs.
+fn profile_slope(regime: u32, z: f32, u_star: f32, ks: f32, nu: f32) -> f32 {
+    let z0 = z0_in(regime, u_star, ks, nu);
+    return (log(z / z0) + Z0_SMOOTH * nu / (u_star * z0)) / KARMAN;
+}
+
+// Newton's method from the bracket's top, a step that leaves the bracket bisecting it and one
+// shorter than half the tolerance taken at that length (`narrow_bracket` in shields.rs).
+fn narrow_bracket(regime: u32, u: f32, z: f32, ks: f32, nu: f32, lo_in: f32, hi_in: f32) -> f32 {
+    var lo = lo_in;
+    var hi = hi_in;
+    var x = hi;
+    var excess = log_profile(regime, z, hi, ks, nu) - u;
+    var iterations = 0u;
+    while (hi - lo > BISECTION_REL_TOL * hi && iterations < FRICTION_VELOCITY_MAX_ITERATIONS) {
+        let shortest = 0.5 * BISECTION_REL_TOL * x;
+        var newton = excess / profile_slope(regime, z, x, ks, nu);
+        if (abs(newton) < shortest) {
+            newton = select(-shortest, shortest, excess >= 0.0);
+        }
+        var next = x - newton;
+        if (!(next > lo && next < hi)) {
+            next = 0.5 * (lo + hi);
+            if (next <= lo || next >= hi) {
+                break;
+            }
+        }
+        iterations++;
+        x = next;
+        excess = log_profile(regime, z, x, ks, nu) - u;
+        if (excess >= 0.0) {
+            hi = x;
+        } else {
+            lo = x;
+        }
+    }
+    return hi;
 }
 
 // Eq. 22: k_beta, flow down the slope or up it.
