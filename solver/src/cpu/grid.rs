@@ -61,11 +61,11 @@ impl Grid {
     pub fn coords(&self, x: &[f32; 3]) -> [i32; 3] {
         let mut c = [0; 3];
         for k in 0..3 {
-            let hi = (self.dims[k] - 1) as f32;
-            // NaN falls to cell 0, where the health check will have it.
-            c[k] = ((x[k] - self.origin[k]) * self.inv_cell)
-                .floor()
-                .clamp(0.0, hi) as i32;
+            // Truncation is the floor wherever the clamp keeps the result (t >= 0), and needs no
+            // call into libm, which `floor` is on baseline x86-64. NaN falls to cell 0, where
+            // the health check will have it; infinities saturate into the border cells.
+            let t = (x[k] - self.origin[k]) * self.inv_cell;
+            c[k] = (t as i32).clamp(0, self.dims[k] - 1);
         }
         c
     }
@@ -223,3 +223,60 @@ pub fn gather<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
 
 /// Fewest particles a thread takes in the sort's parallel loops: less is not worth a wake-up.
 const PAR_MIN: usize = 4096;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bytemuck::Zeroable;
+
+    /// `cell_coords` of grid.wgsl, by floor: what `coords` must give for any point.
+    fn by_floor(grid: &Grid, x: &[f32; 3]) -> [i32; 3] {
+        std::array::from_fn(|k| {
+            let hi = (grid.dims[k] - 1) as f32;
+            ((x[k] - grid.origin[k]) * grid.inv_cell)
+                .floor()
+                .clamp(0.0, hi) as i32
+        })
+    }
+
+    #[test]
+    fn cells_of_points_inside_outside_and_not_finite_are_those_of_the_shader() {
+        let mut sim = SimParams::zeroed();
+        sim.grid_dims = [7, 5, 3, 0];
+        sim.grid_origin = [-0.1, 0.2, 0.0, 1.0 / 0.05];
+        sim.n_cells = 7 * 5 * 3;
+        let grid = Grid::new(&sim, 1);
+        // Cell edges, points just below the origin (truncation would give 0 there too, but
+        // -1.5 cells and beyond must clamp), far outside, and not finite.
+        let values = [
+            -0.1,
+            -0.1 - 1e-7,
+            -0.125,
+            -0.2,
+            -1e30,
+            0.0,
+            0.049_999,
+            0.05,
+            0.2,
+            0.25,
+            0.2999,
+            0.3,
+            0.5,
+            1e30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        let mut edge_cases = 0;
+        for &a in &values {
+            for &b in &values {
+                let x = [a, b, a - b];
+                let got = grid.coords(&x);
+                assert_eq!(got, by_floor(&grid, &x), "{x:?}");
+                edge_cases += usize::from(got.contains(&0) || got[0] == 6 || got[1] == 4);
+            }
+        }
+        assert!(edge_cases > 100, "{edge_cases}");
+        assert_eq!(grid.coords(&[0.026, 0.31, 0.07]), [2, 2, 1]);
+    }
+}
