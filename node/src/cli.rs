@@ -77,7 +77,9 @@ pub struct RunArgs {
     /// Keep DDS on the loopback interface (tests, a single machine).
     #[arg(long)]
     pub loopback: bool,
-    /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk.
+    /// Also write gauges.csv, bed_profile.csv and eroded_mass.csv here, a row per chunk, and
+    /// at the end gauges.png (the published levels, predicted against measured) and
+    /// eroded_mass.png.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Stop once simulated time reaches this, s (scripted runs and tests).

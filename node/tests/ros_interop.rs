@@ -107,6 +107,8 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
         "{matched}"
     );
 
+    plots_hold_both_lines(&out_dir, &node_log);
+
     // The gauge comparison: predicted is the solver's P1 at that time (gauges.csv), measured
     // one of the levels the peer sent, residual their difference.
     let gauges = csv_rows(&out_dir.join("gauges.csv"));
@@ -267,4 +269,40 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
         assert!(values.get(key).is_some(), "no {key} in {values}");
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// At --until the twin drew its plots beside the CSV files: gauges.png with the levels the
+/// peer sent (the measured line's colour in `series_plot.rs`) beside its own (the predicted
+/// line's), and below them the residuals (P1's residual colour). A plot of the solver's
+/// levels alone, one without the residual panel, or none, fails.
+fn plots_hold_both_lines(out_dir: &std::path::Path, node_log: &str) {
+    for name in ["gauges.png", "eroded_mass.png"] {
+        let path = out_dir.join(name);
+        assert!(
+            node_log.contains(&format!("plot: {}", path.display())),
+            "{name} not drawn:\n{node_log}"
+        );
+    }
+    let decoder =
+        png::Decoder::new(std::fs::File::open(out_dir.join("gauges.png")).expect("opens"));
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("decodes");
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    let pixels_near = |colour: [u8; 3]| {
+        buf[..info.buffer_size()]
+            .chunks_exact(3)
+            .filter(|p| p.iter().zip(colour).all(|(a, b)| a.abs_diff(b) < 40))
+            .count()
+    };
+    let predicted = pixels_near([40, 90, 200]);
+    let measured = pixels_near([200, 80, 40]);
+    let residual = pixels_near([0, 160, 190]);
+    eprintln!(
+        "gauges.png: {predicted} pixels of the predicted lines, {measured} of the measured, {residual} of P1's residual"
+    );
+    assert!(
+        predicted > 200 && measured > 200 && residual > 200,
+        "predicted {predicted}, measured {measured}, residual {residual} pixels"
+    );
 }

@@ -7,6 +7,7 @@
 
 use crate::adapters::bag::BagFile;
 use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
+use crate::adapters::files::series_plot::SeriesPlots;
 use crate::adapters::foxglove::LiveView;
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::ros::parameters::{ParameterServices, ParameterStream, live_parameters};
@@ -77,6 +78,7 @@ async fn serve(
         service: args.frames_service.clone(),
         rate_hz: args.frames_rate_hz,
     });
+    let case_name = case.name.clone();
     let solver = solver_thread::spawn(case, args.out.clone(), frames)?;
     let (adapter, particles) = (&solver.link.adapter, solver.link.particles);
     println!("adapter: {adapter}\nparticles: {particles}\nnode: {namespace} {node_name}");
@@ -133,6 +135,7 @@ async fn serve(
         fallback,
         reports: solver.reports,
         live,
+        plots: args.out.as_ref().map(|_| SeriesPlots::compared()),
     };
     drive(&mut twin, &mut wire).await?;
     // Closing the solver's channel: it finishes its chunk and stops.
@@ -143,6 +146,11 @@ async fn serve(
     let joined = tokio::task::spawn_blocking(move || solver.handle.join()).await;
     if !matches!(joined, Ok(Ok(()))) {
         log::warn!("the solver thread panicked");
+    }
+    if let (Some(plots), Some(dir)) = (&wire.plots, &args.out) {
+        for path in plots.draw(dir, &case_name)? {
+            println!("plot: {}", path.display());
+        }
     }
     Ok(())
 }
@@ -228,6 +236,9 @@ struct Wire<'a> {
     fallback: mpsc::Receiver<Sample>,
     reports: mpsc::UnboundedReceiver<Result<Report, String>>,
     live: Arc<Mutex<Settings>>,
+    /// With `--out`: the published levels and eroded mass, drawn beside the CSV files at
+    /// the end.
+    plots: Option<SeriesPlots>,
 }
 
 /// Hands each event to the twin and sends what it gives back, until Ctrl-C, SIGTERM or
@@ -277,6 +288,9 @@ async fn drive(twin: &mut Twin, wire: &mut Wire<'_>) -> Result<()> {
                 let report = report.map_err(|e| anyhow!("the solver stopped: {e}"))?;
                 if let Some(out) = twin.report(report) {
                     let last = out.last;
+                    if let (Some(plots), Some(o)) = (wire.plots.as_mut(), &out.outputs) {
+                        plots.compare(twin.sim_t(), &o.comparison, o.eroded.as_ref());
+                    }
                     wire.outlets.publish(&mut wire.tap, out).await;
                     if last {
                         println!("reached t = {:.3} s (--until)", twin.sim_t());
