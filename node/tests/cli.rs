@@ -300,16 +300,7 @@ fn an_inflow_the_inlet_cannot_carry_is_refused_up_front() {
 /// Reads a snapshot with meshio, a VTK reader nobody here wrote (tests/interop/read_vtk.py).
 /// `scripts/test.sh` installs it; outside CI a machine without it skips with a note.
 fn read_with_meshio(path: &Path, n: usize) {
-    let has_meshio = Command::new("python3")
-        .args(["-c", "import meshio"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has_meshio {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true but python3 cannot import meshio (scripts/test.sh installs it)"
-        );
-        eprintln!("note: python3 with meshio not found; the independent VTK read is skipped");
+    if !common::python_has("meshio", "meshio") {
         return;
     }
     let out = Command::new("python3")

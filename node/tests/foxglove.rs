@@ -21,22 +21,17 @@ fn client_dir() -> PathBuf {
     repo_file("tests/interop/foxglove_client")
 }
 
-/// Whether Node and the client's packages are there; without them the test skips with a note,
-/// except under CI=true, where `scripts/test.sh` installs them and a miss is a failure.
+/// Whether Node and the client's packages are there (see `common::ready`).
 fn node_client_ready() -> bool {
-    let ok = Command::new("node")
+    let probe = Command::new("node")
         .current_dir(client_dir())
         .args(["-e", "import('@foxglove/ws-protocol')"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true and Node cannot load the Foxglove client (scripts/test.sh installs it)"
-        );
-        eprintln!("note: skipping, npm ci --prefix tests/interop/foxglove_client");
-    }
-    ok
+        .output();
+    common::ready(
+        probe.is_ok_and(|o| o.status.success()),
+        "Node cannot load the Foxglove client",
+        "npm ci --prefix tests/interop/foxglove_client",
+    )
 }
 
 /// The twin at CI size on the CPU backend, serving Foxglove on a port the system picks, in a

@@ -7,7 +7,7 @@
 use flume_msgs::RosMessage;
 mod common;
 
-use common::{gpu, read_until, repo_file};
+use common::{KillOnDrop, gpu, read_until, recycle_twin};
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::diagnostic_msgs::DiagnosticArray;
 use flume_msgs::flume_msgs::GaugeComparison;
@@ -25,18 +25,8 @@ use ros2_client::{
     QosProfile, ServiceMapping, ServiceTypeName,
 };
 use std::net::Ipv4Addr;
-use std::process::{Child, Command, Stdio};
+use std::process::Stdio;
 use std::time::Duration;
-
-/// Kills the twin however the test ends.
-struct Twin(Child);
-
-impl Drop for Twin {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 fn set(name: &str, value: ParameterValue) -> SetParametersRequest {
     SetParametersRequest {
@@ -136,15 +126,9 @@ fn parameters_and_services_from_another_process_control_the_twin() {
 }
 
 fn control_the_twin() -> Result<(), Unmatched> {
-    let mut twin = Twin(
-        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+    let mut twin = KillOnDrop(
+        recycle_twin()
             .args([
-                "run",
-                repo_file("solver/tests/cases/recycle_2d.yaml")
-                    .to_str()
-                    .expect("utf-8"),
-                "--loopback",
-                "--no-replay",
                 "--wait-for-sensors",
                 "--gauge-msg",
                 "range",

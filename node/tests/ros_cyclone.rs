@@ -8,20 +8,10 @@
 
 mod common;
 
-use common::{gpu, python_has, read_until, repo_file};
+use common::{KillOnDrop, gpu, python_has, read_until, recycle_twin, repo_file};
 use serde_json::Value;
 use std::io::Read;
-use std::process::{Child, Command, Output, Stdio};
-
-/// Kills the twin however the test ends.
-struct Twin(Child);
-
-impl Drop for Twin {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+use std::process::{Command, Output, Stdio};
 
 /// The peer's answers of kind `kind`, in order.
 fn answers<'a>(lines: &'a [Value], kind: &str) -> Vec<&'a Value> {
@@ -69,21 +59,9 @@ fn a_cyclone_dds_client_sets_parameters_and_calls_the_services_as_ros2_cli_does(
 
 /// A twin and the peer's session against it: the peer's output, and all the twin printed.
 fn session() -> (Output, String) {
-    let mut twin = Twin(
-        Command::new(env!("CARGO_BIN_EXE_flume-twin"))
-            .args([
-                "run",
-                repo_file("solver/tests/cases/recycle_2d.yaml")
-                    .to_str()
-                    .expect("utf-8"),
-            ])
-            .args([
-                "--loopback",
-                "--no-replay",
-                "--ros-args",
-                "-r",
-                "__ns:=/flume_cy",
-            ])
+    let mut twin = KillOnDrop(
+        recycle_twin()
+            .args(["--ros-args", "-r", "__ns:=/flume_cy"])
             .args([
                 "-p",
                 "target_real_time_factor:=0.5",

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{csv_rows, gpu, python_has, repo_file};
+use common::{csv_rows, gpu, python_has, recycle_twin, repo_file};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::process::{Command, Stdio};
@@ -28,14 +28,8 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
     // simulated time never passes the sensors', so it runs at least 3 s of wall time: the
     // peer's bad samples (at 1.3 s) reach a /diagnostics (1 Hz) before it ends. At 0.5 s a
     // twin that kept up ended before that, and the refusal counts were never seen.
-    let node = Command::new(env!("CARGO_BIN_EXE_flume-twin"))
+    let node = recycle_twin()
         .args([
-            "run",
-            repo_file("solver/tests/cases/recycle_2d.yaml")
-                .to_str()
-                .expect("utf-8"),
-            "--loopback",
-            "--no-replay",
             "--wait-for-sensors",
             "--until",
             "3.0",

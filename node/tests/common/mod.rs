@@ -54,19 +54,28 @@ pub fn csv_rows(path: &Path) -> Vec<BTreeMap<String, String>> {
         .collect()
 }
 
-/// Whether python3 can `import modules` (comma-separated); without them a test skips with a
-/// note, except under CI=true, where `scripts/test.sh` installs them and a miss is a failure.
+/// Whether python3 can `import modules` (comma-separated); see [`ready`].
 pub fn python_has(modules: &str, pip: &str) -> bool {
-    let ok = std::process::Command::new("python3")
+    let probe = std::process::Command::new("python3")
         .args(["-c", &format!("import {modules}")])
-        .output()
-        .is_ok_and(|o| o.status.success());
+        .output();
+    ready(
+        probe.is_ok_and(|o| o.status.success()),
+        &format!("python3 cannot import {modules}"),
+        &format!("pip install {pip}"),
+    )
+}
+
+/// `ok`, whether a reader a test needs is installed; without it the test skips with a note
+/// saying how to install it (`install`), except under CI=true, where `scripts/test.sh`
+/// installs it and a miss (`missing`) is a failure.
+pub fn ready(ok: bool, missing: &str, install: &str) -> bool {
     if !ok {
         assert!(
             std::env::var("CI").as_deref() != Ok("true"),
-            "CI=true and python3 cannot import {modules} (scripts/test.sh installs them)"
+            "CI=true and {missing} (scripts/test.sh installs it)"
         );
-        eprintln!("note: skipping, pip install {pip}");
+        eprintln!("note: skipping, {install}");
     }
     ok
 }
@@ -99,6 +108,26 @@ pub fn ulbra_twin() -> std::process::Command {
         .args(ULBRA_CI)
         .arg("--loopback");
     twin
+}
+
+/// `flume-twin run` on the small recycling tank (`recycle_2d.yaml`), DDS on loopback only and
+/// no recorded session in the sensors' place; the test adds its own options.
+pub fn recycle_twin() -> std::process::Command {
+    let mut twin = std::process::Command::new(env!("CARGO_BIN_EXE_flume-twin"));
+    twin.arg("run")
+        .arg(repo_file("solver/tests/cases/recycle_2d.yaml"))
+        .args(["--loopback", "--no-replay"]);
+    twin
+}
+
+/// A child process killed however the test ends.
+pub struct KillOnDrop(pub std::process::Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
 }
 
 /// A recording as Python's `mcap` and `mcap-ros2-support` read it
