@@ -87,10 +87,11 @@ fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> f32 {
         if (regime == 0u) {
             hi = min(hi, u * KARMAN / log(50.0));
         }
-        if (log_profile(regime, z, hi, ks, nu) < u) {
+        let excess = log_profile(regime, z, hi, ks, nu) - u;
+        if (excess < 0.0) {
             continue;
         }
-        return narrow_bracket(regime, u, z, ks, nu, lo, hi);
+        return narrow_bracket(regime, u, z, ks, nu, lo, hi, excess);
     }
     return sublayer_top;
 }
@@ -103,11 +104,13 @@ fn profile_slope(regime: u32, z: f32, u_star: f32, ks: f32, nu: f32) -> f32 {
 
 // Newton's method from the bracket's top, a step that leaves the bracket bisecting it and one
 // shorter than half the tolerance taken at that length (`narrow_bracket` in shields.rs).
-fn narrow_bracket(regime: u32, u: f32, z: f32, ks: f32, nu: f32, lo_in: f32, hi_in: f32) -> f32 {
+fn narrow_bracket(
+    regime: u32, u: f32, z: f32, ks: f32, nu: f32, lo_in: f32, hi_in: f32, excess_in: f32
+) -> f32 {
     var lo = lo_in;
     var hi = hi_in;
     var x = hi;
-    var excess = log_profile(regime, z, hi, ks, nu) - u;
+    var excess = excess_in;
     var iterations = 0u;
     while (hi - lo > BISECTION_REL_TOL * hi && iterations < FRICTION_VELOCITY_MAX_ITERATIONS) {
         let shortest = 0.5 * BISECTION_REL_TOL * x;

@@ -269,11 +269,12 @@ pub fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> FrictionVelocity {
             Roughness::Smooth => hi.min(u * KARMAN / 50.0_f32.ln()),
             Roughness::Transitional => hi,
         };
-        if f(hi) < u {
+        let excess = f(hi) - u;
+        if excess < 0.0 {
             continue;
         }
         let slope = |u_star: f32| profile_slope(regime, z, u_star, ks, nu);
-        return narrow_bracket(u, (lo, hi), f, slope);
+        return narrow_bracket(u, (lo, hi), excess, f, slope);
     }
     FrictionVelocity {
         u_star: sublayer_top,
@@ -292,17 +293,18 @@ fn profile_slope(regime: Roughness, z: f32, u_star: f32, ks: f32, nu: f32) -> f3
 
 /// The smallest u* of the bracket `(lo, hi)` at which the increasing profile `f` (with slope
 /// `slope`) reaches `u`, to [`BISECTION_REL_TOL`]: `f(lo) < u <= f(hi)` on entry and after every
-/// step. Newton's method starts from the top; the profile is convex there, so its steps come
+/// step, `excess` being `f(hi) - u` on entry. Newton's method starts from the top; the profile is convex there, so its steps come
 /// down onto the root from above. Once a step would be shorter than half the tolerance it is
 /// taken at that length, which crosses the root and closes the bracket. A step that would
 /// leave the bracket (where the profile is not convex) bisects it instead.
 fn narrow_bracket(
     u: f32,
     (mut lo, mut hi): (f32, f32),
+    mut excess: f32,
     f: impl Fn(f32) -> f32,
     slope: impl Fn(f32) -> f32,
 ) -> FrictionVelocity {
-    let (mut x, mut excess) = (hi, f(hi) - u);
+    let mut x = hi;
     let mut iterations = 0;
     while hi - lo > BISECTION_REL_TOL * hi {
         if iterations == FRICTION_VELOCITY_MAX_ITERATIONS {
