@@ -147,8 +147,12 @@ async fn serve(
     if !matches!(joined, Ok(Ok(()))) {
         log::warn!("the solver thread panicked");
     }
-    if let (Some(plots), Some(dir)) = (&wire.plots, &args.out) {
-        for path in plots.draw(dir, &case_name)? {
+    if let (Some(plots), Some(dir)) = (wire.plots.take(), args.out.clone()) {
+        // Drawing and encoding PNGs is blocking work too.
+        let drawn = tokio::task::spawn_blocking(move || plots.draw(&dir, &case_name))
+            .await
+            .context("drawing the plots failed")??;
+        for path in drawn {
             println!("plot: {}", path.display());
         }
     }
