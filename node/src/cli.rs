@@ -327,4 +327,31 @@ pub struct BenchArgs {
         allow_negative_numbers = true
     )]
     pub steps_seconds: f64,
+    /// Run the --flume case at a constant discharge to a steady state at each --dp instead,
+    /// and print its levels against the 1-D hydraulic reference, its outflow against its
+    /// inflow, and the water's stand-off from the bed.
+    #[arg(long, conflicts_with_all = ["ladder", "case", "frames"])]
+    pub levels: bool,
+    /// With --levels: the resolutions to run, m.
+    #[arg(
+        long,
+        value_name = "DP1,DP2,...",
+        value_delimiter = ',',
+        default_value = "0.01,0.007,0.005",
+        requires = "levels"
+    )]
+    pub dp: Vec<f64>,
+    /// With --levels: the constant discharge, m3/h.
+    #[arg(long, value_name = "Q", default_value_t = 2.0, requires = "levels", value_parser = positive)]
+    pub m3_per_h: f64,
+    /// With --levels: how long each run lasts, s of flume time (at least 20: the levels are
+    /// averaged over the last 10 s and the drift taken against the 10 s before).
+    #[arg(long, value_name = "T_S", default_value_t = 60.0, requires = "levels")]
+    pub until: f64,
+    /// With --levels: the sand bed replaced by a fixed wall block of its shape (clear water).
+    #[arg(long, requires = "levels")]
+    pub fixed_bed: bool,
+    /// With --levels: override a field of the flume case (repeatable), as `simulate --set`.
+    #[arg(long = "set", value_name = "KEY=VALUE", requires = "levels")]
+    pub set: Vec<String>,
 }

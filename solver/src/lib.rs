@@ -30,6 +30,8 @@ pub use simulation::{InflowSchedule, RefusedInflow, Simulation};
 
 /// The case file's types: `Case` and its sections.
 pub mod config;
+/// The 1-D hydraulic reference for an open flume's steady levels (weir rating, backwater curve).
+pub mod hydraulics;
 /// The reference model: every formula once, called by both backends and by the O(N^2) oracle
 /// that the tests compare them with.
 pub mod physics;

@@ -57,6 +57,28 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.frames {
         return super::bench_frames::run(&args.flume, args.steps_seconds);
     }
+    if args.levels {
+        if !(args.until >= 20.0) {
+            bail!(
+                "--until: {} s is too short to measure a drift; use at least 20",
+                args.until
+            );
+        }
+        if let Some(dp) = args.dp.iter().find(|dp| !(dp.is_finite() && **dp > 0.0)) {
+            bail!("--dp: {dp} is not a positive length in metres");
+        }
+        let runs: Vec<super::bench_levels::LevelRun> = args
+            .dp
+            .iter()
+            .map(|&dp_m| super::bench_levels::LevelRun {
+                dp_m,
+                m3_per_h: args.m3_per_h,
+                until_s: args.until,
+                fixed_bed: args.fixed_bed,
+            })
+            .collect();
+        return super::bench_levels::run(&args.flume, &args.set, &runs);
+    }
     if let Some(n) = args.ladder.iter().find(|n| **n < 100) {
         bail!("--ladder: {n} particles is too few for a dam break; use at least 100");
     }

@@ -3,11 +3,11 @@
 //! bundled `tests/data/ulbra_session.mcap`; anyone can remake it, or a longer one.
 //!
 //! The hydraulic model, for an open flume with a horizontal bed:
-//! - The steady water surface for unit discharge q = Q / W is the gradually varied flow
-//!   dh/dx = -Sf / (1 - Fr^2), integrated upstream from critical depth h_c = (q^2/g)^(1/3)
-//!   over the downstream weir. The friction slope is Manning's, Sf = n^2 V^2 / R^(4/3), with
-//!   Strickler's n = ks^(1/6) / 21.1 for the case's sand roughness ks and the hydraulic radius
-//!   of the rectangular channel, R = W h / (W + 2 h).
+//! - The steady water surface for unit discharge q = Q / W is the 1-D reference of
+//!   `flume_solver::hydraulics` (the weir's rating, the drop into the collector pit, the
+//!   backwater curve over the bed with Strickler's n for the sand), on the case's geometry as
+//!   written and with the bed's friction alone, as the 2-D twin has it (the glass side walls'
+//!   share is left out: a twin without a wall-shear term could not follow it).
 //! - The flume starts dry and fills from the inlet: the front is where the water that has
 //!   entered, the integral of Q, fills the steady profile from the inlet wall. A gauge reads the
 //!   bed ahead of the front and the steady surface behind it, over a ramp of `FRONT_M`.
@@ -30,12 +30,10 @@ use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::flume_msgs::{Discharge, WaterLevel};
 use flume_msgs::std_msgs::Header;
 use flume_solver::Case;
+use flume_solver::hydraulics::{Channel, DX_M, Profile};
 
-const G: f64 = 9.81;
 /// Length over which the filling front's level rises from the bed, m.
 const FRONT_M: f64 = 0.1;
-/// Step of the surface-profile integration, m.
-const DX_M: f64 = 0.001;
 const INFLOW_RATE_HZ: f64 = 2.0;
 const INFLOW_SIGMA_REL: f64 = 0.01;
 const GAUGE_RATE_HZ: f64 = 10.0;
@@ -43,91 +41,19 @@ const GAUGE_SIGMA_M: f64 = 0.5e-3;
 const GAUGE_RESOLUTION_M: f64 = 1e-4;
 const LATENCY_S: f64 = 0.002;
 
-/// The flume as the hydraulic model sees it.
-#[derive(Debug, Clone)]
-pub struct Channel {
-    pub width_m: f64,
-    /// The inlet wall's x and the weir's x, m.
-    pub x_inlet_m: f64,
-    pub x_weir_m: f64,
-    pub bed_m: f64,
-    pub weir_crest_m: f64,
-    pub manning_n: f64,
-}
-
-impl Channel {
-    pub fn from_case(case: &Case) -> Result<Channel> {
-        let Some(flume) = &case.open_flume else {
-            bail!("{}: a session needs an open flume", case.name);
-        };
-        if case.dim() != 2 {
-            bail!("{}: the session model is for 2-D flumes", case.name);
-        }
-        let sediments: Vec<&str> = case
-            .phases
-            .iter()
-            .filter(|p| p.sediment.is_some())
-            .map(|p| p.name.as_str())
-            .collect();
-        let bed_m = case
-            .fluid_blocks
-            .iter()
-            .filter(|b| sediments.contains(&b.phase.as_str()))
-            .map(|b| b.max_m[1])
-            .fold(case.domain.min_m[1], f64::max);
-        let ks_m = case
-            .phases
-            .iter()
-            .find_map(|p| p.sediment.as_ref())
-            .map_or(1e-3, |s| s.ks_over_d50 * s.d50_m);
-        Ok(Channel {
-            width_m: flume.width_m,
-            x_inlet_m: case.domain.min_m[0],
-            x_weir_m: case.domain.max_m[0],
-            bed_m,
-            weir_crest_m: flume.outlet_weir_m,
-            manning_n: ks_m.powf(1.0 / 6.0) / 21.1,
-        })
-    }
-
-    /// The steady depth over the bed, m, at `DX_M` steps from the inlet wall to the weir, for
-    /// discharge `q_m3_per_s`.
-    pub fn steady_depths(&self, q_m3_per_s: f64) -> Vec<f64> {
-        let q = q_m3_per_s / self.width_m;
-        let hc = (q * q / G).cbrt();
-        let n = ((self.x_weir_m - self.x_inlet_m) / DX_M).ceil() as usize;
-        let mut h = vec![0.0; n + 1];
-        // The critical section is on the crest; the integration starts just above it, where
-        // the equation is regular.
-        h[n] = (self.weir_crest_m + hc - self.bed_m).max(hc) * 1.001;
-        for k in (0..n).rev() {
-            let d = h[k + 1];
-            let v = q / d;
-            let r = self.width_m * d / (self.width_m + 2.0 * d);
-            let sf = self.manning_n.powi(2) * v * v / r.powf(4.0 / 3.0);
-            let fr2 = (v * v / (G * d)).min(0.99);
-            h[k] = d + sf / (1.0 - fr2) * DX_M;
-        }
-        h
-    }
-
-    fn volume_m3(&self, depths: &[f64], upto: usize) -> f64 {
-        depths[..upto.min(depths.len())].iter().sum::<f64>() * DX_M * self.width_m
-    }
-}
-
 /// The levels a session's gauges read, m above the floor, at time `t` with the discharge
 /// history `schedule` ((from t, Q) rows, the first at 0).
 pub struct LevelModel {
     channel: Channel,
+    width_m: f64,
     schedule: Vec<(f64, f64)>,
-    profiles: Vec<Vec<f64>>,
+    profiles: Vec<Profile>,
     /// The time the front reaches the weir, s.
     filled_s: f64,
 }
 
 impl LevelModel {
-    pub fn new(channel: Channel, schedule: Vec<(f64, f64)>) -> Result<LevelModel> {
+    pub fn new(channel: Channel, width_m: f64, schedule: Vec<(f64, f64)>) -> Result<LevelModel> {
         if schedule.first().is_none_or(|s| s.0 != 0.0) {
             bail!("the discharge schedule must start at t = 0");
         }
@@ -138,11 +64,11 @@ impl LevelModel {
                 bad.0
             );
         }
-        let profiles: Vec<Vec<f64>> = schedule
+        let profiles: Vec<Profile> = schedule
             .iter()
-            .map(|s| channel.steady_depths(s.1))
+            .map(|s| channel.steady(s.1, width_m))
             .collect();
-        let filled_s = channel.volume_m3(&profiles[0], usize::MAX) / schedule[0].1;
+        let filled_s = profiles[0].volume_m2(&channel.weir) * width_m / schedule[0].1;
         if let Some(early) = schedule.iter().skip(1).find(|s| s.0 < filled_s) {
             bail!(
                 "a discharge change at t = {} s comes before the flume has filled ({filled_s:.1} s); \
@@ -152,6 +78,7 @@ impl LevelModel {
         }
         Ok(LevelModel {
             channel,
+            width_m,
             schedule,
             profiles,
             filled_s,
@@ -175,33 +102,36 @@ impl LevelModel {
     /// The water level at `x` at `t`, m above the floor (the bed's level where it is dry).
     pub fn level(&self, x: f64, t: f64) -> f64 {
         let c = &self.channel;
-        let k =
-            (((x - c.x_inlet_m) / DX_M).round().max(0.0) as usize).min(self.profiles[0].len() - 1);
         if t < self.filled_s {
-            let depths = &self.profiles[0];
-            let entered = self.schedule[0].1 * t;
-            let front = (0..depths.len())
-                .find(|&j| c.volume_m3(depths, j) >= entered)
-                .unwrap_or(depths.len()) as f64
-                * DX_M
-                + c.x_inlet_m;
+            // The front is where the water that has entered fills the steady profile from the
+            // inlet wall.
+            let depths = &self.profiles[0].depths_m;
+            let entered_m2 = self.schedule[0].1 * t / self.width_m;
+            let mut stored_m2 = 0.0;
+            let wet_columns = depths
+                .iter()
+                .take_while(|h| {
+                    stored_m2 += *h * DX_M;
+                    stored_m2 < entered_m2
+                })
+                .count();
+            let front = c.x_inlet_m + wet_columns as f64 * DX_M;
             let wet = ((front - x) / FRONT_M).clamp(0.0, 1.0);
-            return c.bed_m + wet * depths[k];
+            return c.bed_m + wet * (self.profiles[0].level_m(x) - c.bed_m);
         }
-        let mut depth = self.profiles[0][k];
+        let mut level = self.profiles[0].level_m(x);
         for (i, &(t_change, q)) in self.schedule.iter().enumerate().skip(1) {
             if t < t_change {
                 break;
             }
-            let old = &self.profiles[i - 1];
-            let new = &self.profiles[i];
-            let dq = q - self.schedule[i - 1].1;
-            let dv = c.volume_m3(new, usize::MAX) - c.volume_m3(old, usize::MAX);
+            let (old, new) = (&self.profiles[i - 1], &self.profiles[i]);
+            let dq = (q - self.schedule[i - 1].1) / self.width_m;
+            let dv = new.volume_m2(&c.weir) - old.volume_m2(&c.weir);
             let tau = (dv / dq).abs().max(1e-3);
             let relaxed = 1.0 - (-(t - t_change) / tau).exp();
-            depth += (new[k] - depth) * relaxed;
+            level += (new.level_m(x) - level) * relaxed;
         }
-        c.bed_m + depth
+        level
     }
 }
 
@@ -239,7 +169,7 @@ pub fn run(args: &MakeSessionArgs) -> Result<()> {
         .open_flume
         .clone()
         .context("the case has no open flume")?;
-    let channel = Channel::from_case(&case)?;
+    let channel = Channel::from_case(&case).map_err(anyhow::Error::msg)?;
     let mut schedule = vec![(0.0, flume.inflow_m3_per_s)];
     if let Some(t) = args.change_at_s {
         let q = args
@@ -248,7 +178,7 @@ pub fn run(args: &MakeSessionArgs) -> Result<()> {
             / 3600.0;
         schedule.push((t, q));
     }
-    let model = LevelModel::new(channel, schedule)?;
+    let model = LevelModel::new(channel, flume.width_m, schedule)?;
     let mut bag = BagWriter::create(&args.out, None)?;
     let frame_id = "flume".to_string();
     let inflow_ch =
@@ -320,52 +250,38 @@ mod tests {
     use super::*;
 
     fn ulbra() -> Channel {
-        Channel {
-            width_m: 0.086,
-            x_inlet_m: 0.0,
-            x_weir_m: 2.5,
-            bed_m: 0.055,
-            weir_crest_m: 0.055,
-            manning_n: 0.0012f64.powf(1.0 / 6.0) / 21.1,
-        }
-    }
-
-    #[test]
-    fn the_steady_surface_rises_upstream_from_critical_depth() {
-        let c = ulbra();
-        let q = 2.0 / 3600.0;
-        let h = c.steady_depths(q);
-        // q = 6.46e-3 m2/s: h_c = (q^2 / g)^(1/3) = 16.2 mm.
-        let hc = ((q / 0.086f64).powi(2) / 9.81).cbrt();
-        assert!((hc - 0.0162).abs() < 1e-4, "{hc}");
-        assert!((h[h.len() - 1] - hc).abs() < 1e-4);
-        assert!(h.windows(2).all(|w| w[0] >= w[1]), "a backwater curve");
-        // Over 2.5 m at a friction slope of a few 1e-3 the depth grows by millimetres, not
-        // centimetres: a subcritical flow of 2-3 cm over the whole bed.
-        assert!(h[0] > hc + 0.002 && h[0] < 0.035, "{}", h[0]);
+        let case = Case::from_path(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../launch_configs/ulbra_flume.yaml"
+        )))
+        .expect("the bundled case");
+        Channel::from_case(&case).expect("a flume")
     }
 
     #[test]
     fn the_front_fills_the_flume_with_the_water_that_entered() {
         let q = 2.0 / 3600.0;
-        let m = LevelModel::new(ulbra(), vec![(0.0, q), (60.0, 1.25 * q)]).expect("valid");
-        let v = ulbra().volume_m3(&ulbra().steady_depths(q), usize::MAX);
-        assert!((m.filled_s() - v / q).abs() < 1e-9);
+        let w = 0.086;
+        let m = LevelModel::new(ulbra(), w, vec![(0.0, q), (60.0, 1.25 * q)]).expect("valid");
+        let steady = ulbra().steady(q, w);
+        assert!((m.filled_s() - steady.volume_m2(&ulbra().weir) * w / q).abs() < 1e-9);
         // Dry ahead of the front, wet behind it.
-        let t = 0.5 * m.filled_s();
-        assert_eq!(m.level(2.4, t), 0.055);
+        let t = 0.3 * m.filled_s();
+        assert_eq!(m.level(2.0, t), 0.055);
         assert!(m.level(0.2, t) > 0.055 + 0.015);
+        // Once filled, the steady profile.
+        assert_eq!(m.level(1.0, 59.0), steady.level_m(1.0));
         // The change relaxes towards the higher profile.
         let before = m.level(1.0, 59.9);
         let after = m.level(1.0, 200.0);
-        let h = ulbra().steady_depths(1.25 * q);
+        let higher = ulbra().steady(1.25 * q, w).level_m(1.0);
         assert!(after > before);
-        assert!((after - 0.055 - h[1000]).abs() < 1e-6);
+        assert!((after - higher).abs() < 1e-6);
         assert!(
-            LevelModel::new(ulbra(), vec![(0.0, q), (1.0, q)]).is_err(),
+            LevelModel::new(ulbra(), w, vec![(0.0, q), (1.0, q)]).is_err(),
             "before filling"
         );
-        assert!(LevelModel::new(ulbra(), vec![(0.0, -q)]).is_err());
+        assert!(LevelModel::new(ulbra(), w, vec![(0.0, -q)]).is_err());
     }
 
     #[test]

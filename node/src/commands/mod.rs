@@ -3,6 +3,7 @@
 
 pub mod bench;
 mod bench_frames;
+mod bench_levels;
 pub mod make_session;
 pub mod play;
 pub mod replay;

@@ -1,0 +1,391 @@
+//! `flume-twin bench --levels`: the open flume run at a constant discharge to a steady state at
+//! each resolution, its levels at the gauges against the 1-D reference of
+//! `flume_solver::hydraulics` on the geometry as generated at that dp (bed friction only, as a
+//! 2-D model has it), and what the sensors cannot check: how far the water stands off the bed
+//! and how hard the held sand pushes back.
+//!
+//! Per run it prints:
+//! - each gauge's mean level over the last 10 s against the reference, and its drift (the last
+//!   10 s' mean less the 10 s' before);
+//! - the discharge over the weir and the one the inlet placed, over the last 10 s, against the
+//!   discharge asked (particles parked at the outlet, dp^2 each per metre of width);
+//! - at the end, in 10 cm columns from x = 0.3 to 2.1 m: the 5th percentile of the water
+//!   particles' heights above the column's top held sand particle (or the fixed bed's top wall
+//!   particle), in dp (the cushion under the flow), and that sand particle's Tait pressure
+//!   over the weight of the water above it.
+//!
+//! Nothing is asserted: the figures are for the log and the issue's goals.
+
+use crate::adapters::table::Table;
+use anyhow::{Context, Result, bail};
+use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, SideWalls};
+use flume_solver::{Backend, Case, Observations, ParticleRegion, Simulation};
+use std::path::Path;
+use std::time::Instant;
+
+/// How often the run is observed, s of flume time.
+const OBSERVE_S: f64 = 1.0;
+/// The window the levels are averaged over, and the drift measured between two of, s.
+const WINDOW_S: f64 = 10.0;
+/// Parked water per square metre of the domain's section, particles x dp^2: enough for the
+/// stored water at 4 m3/h, about 0.15 m2 at any dp.
+const RESERVOIR_M2: f64 = 0.3;
+
+/// What one run is asked.
+pub struct LevelRun {
+    pub dp_m: f64,
+    pub m3_per_h: f64,
+    pub until_s: f64,
+    /// The sand bed replaced by a wall block of its shape (clear water).
+    pub fixed_bed: bool,
+}
+
+/// The counters of the open flume at an observation.
+#[derive(Clone, Copy, Default)]
+struct Books {
+    t: f64,
+    parked: u64,
+    injected: u64,
+    eroded: u64,
+    excluded: u64,
+}
+
+pub fn run(flume: &Path, set: &[String], runs: &[LevelRun]) -> Result<()> {
+    if runs.is_empty() {
+        bail!("--levels: no resolution to run");
+    }
+    // Every case is built before the first run, so a bad value fails at once.
+    let cases = runs
+        .iter()
+        .map(|r| level_case(flume, set, r))
+        .collect::<Result<Vec<_>>>()?;
+    let backend = Backend::choose().context("cannot open a backend")?;
+    println!("backend: {}", backend.describe());
+    for (r, (case, channel)) in runs.iter().zip(&cases) {
+        run_one(&backend, case, channel, r)?;
+    }
+    Ok(())
+}
+
+/// The flume at `r`'s resolution and discharge, with a reservoir large enough for the water it
+/// stores, and its bed made wall when asked: the case file with overrides, validated as
+/// `--set` is.
+/// The reference is the sand bed's as generated at that dp, a fixed bed's too.
+fn level_case(flume: &Path, set: &[String], r: &LevelRun) -> Result<(Case, Channel)> {
+    let base = Case::from_path_with(flume, set).context("the flume case was refused")?;
+    let mut overrides = set.to_vec();
+    overrides.extend([
+        format!("numerics.dp_m={}", r.dp_m),
+        format!("open_flume.inflow_m3_per_s={}", r.m3_per_h / 3600.0),
+        format!(
+            "open_flume.reservoir_particles={}",
+            (RESERVOIR_M2 / (r.dp_m * r.dp_m)).ceil()
+        ),
+        format!("time.end_s={}", r.until_s),
+    ]);
+    let sand = Case::from_path_with(flume, &overrides)
+        .with_context(|| format!("the flume at dp = {} m was refused", r.dp_m))?;
+    let channel = Channel::as_generated(&sand).map_err(anyhow::Error::msg)?;
+    if !r.fixed_bed {
+        return Ok((sand, channel));
+    }
+    {
+        let sediment: Vec<&str> = base
+            .phases
+            .iter()
+            .filter(|p| p.sediment.is_some())
+            .map(|p| p.name.as_str())
+            .collect();
+        let (beds, fluids): (Vec<_>, Vec<_>) = base
+            .fluid_blocks
+            .iter()
+            .partition(|b| sediment.contains(&b.phase.as_str()));
+        let block = |min: &[f64], max: &[f64]| format!("{{min_m: {min:?}, max_m: {max:?}}}");
+        let walls: Vec<String> = base
+            .walls
+            .blocks
+            .iter()
+            .map(|w| block(&w.min_m, &w.max_m))
+            .chain(beds.iter().map(|b| block(&b.min_m, &b.max_m)))
+            .collect();
+        let mut fluids: Vec<String> = fluids
+            .iter()
+            .map(|b| {
+                format!(
+                    "{{phase: {}, min_m: {:?}, max_m: {:?}}}",
+                    b.phase, b.min_m, b.max_m
+                )
+            })
+            .collect();
+        // A case needs some fluid to start with: the collector pit full of water, which it
+        // would be before any water left over the weir.
+        let (channel, water) = (
+            Channel::from_case(&base).map_err(anyhow::Error::msg)?,
+            base.phases
+                .iter()
+                .find(|p| p.sediment.is_none())
+                .context("a water phase")?,
+        );
+        fluids.push(format!(
+            "{{phase: {}, min_m: [{}, {}], max_m: [{}, {}]}}",
+            water.name,
+            channel.x_bed_end_m,
+            channel.weir.floor_m,
+            channel.weir.x_m,
+            channel.weir.crest_m
+        ));
+        overrides.push(format!("walls.blocks=[{}]", walls.join(", ")));
+        overrides.push(format!("fluid_blocks=[{}]", fluids.join(", ")));
+    }
+    let fixed = Case::from_path_with(flume, &overrides)
+        .with_context(|| format!("the flume at dp = {} m was refused", r.dp_m))?;
+    Ok((fixed, channel))
+}
+
+fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> Result<()> {
+    println!();
+    println!(
+        "{} at dp = {} m, {} m3/h, {}, to t = {} s",
+        case.name,
+        r.dp_m,
+        r.m3_per_h,
+        if r.fixed_bed {
+            "the bed a fixed wall (clear water)"
+        } else {
+            "the sand bed"
+        },
+        r.until_s
+    );
+    let mut sim = Simulation::new(backend.clone(), case).context("cannot set up the flume")?;
+    let wall = Instant::now();
+    let mut history: Vec<(Books, Observations)> = Vec::new();
+    let mut t = 0.0;
+    while t < r.until_s - 1e-9 {
+        t = (t + OBSERVE_S).min(r.until_s);
+        sim.advance_to(t)
+            .with_context(|| format!("the run stopped before t = {t} s"))?;
+        let obs = sim.observe()?;
+        let f = sim.flume().context("an open flume")?;
+        let books = Books {
+            t: sim.time_s(),
+            parked: f.parked_particles,
+            injected: f.injected_particles,
+            eroded: f.eroded_particles,
+            excluded: f.excluded_particles,
+        };
+        history.push((books, obs));
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+    println!(
+        "{} particles, {} steps in {:.0} s of wall time: {:.3} x real time",
+        sim.particle_count(),
+        sim.steps(),
+        wall_s,
+        r.until_s / wall_s
+    );
+    print_levels(case, channel, r, &history);
+    print_flow(case, r, &history);
+    print_bed(&sim, case)?;
+    Ok(())
+}
+
+/// The observations at or after `t`, the first of them.
+fn at(history: &[(Books, Observations)], t: f64) -> Option<&(Books, Observations)> {
+    history.iter().find(|(b, _)| b.t >= t - 1e-6)
+}
+
+/// Mean level of gauge `g` over the observations in `(from, to]`, m.
+fn mean_level(history: &[(Books, Observations)], g: usize, from: f64, to: f64) -> Option<f64> {
+    let levels: Vec<f64> = history
+        .iter()
+        .filter(|(b, _)| b.t > from + 1e-6 && b.t <= to + 1e-6)
+        .filter_map(|(_, o)| o.gauges.get(g)?.level_m)
+        .collect();
+    (!levels.is_empty()).then(|| levels.iter().sum::<f64>() / levels.len() as f64)
+}
+
+fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books, Observations)]) {
+    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
+    let q = r.m3_per_h / 3600.0;
+    let reference = channel.steady(q, width);
+    let glass = Channel {
+        side_walls: SideWalls::Glass {
+            width_m: width,
+            manning_n: GLASS_MANNING_N,
+        },
+        ..channel.clone()
+    }
+    .steady(q, width);
+    let q_unit = q / width;
+    let head = channel.weir.head_m(q_unit);
+    println!(
+        "1-D reference on the generated geometry: bed {:.4} m, crest {:.4} m ({:.3} m long), \
+         head {:.1} mm (H / L = {:.2}; a thin plate's, Rehbock: {:.1} mm), Strickler n = {:.4}",
+        channel.bed_m,
+        channel.weir.crest_m,
+        channel.weir.length_m,
+        1e3 * head,
+        head / channel.weir.length_m,
+        1e3 * channel.weir.sharp_head_m(q_unit),
+        channel.manning_n
+    );
+    let end = r.until_s;
+    let mut table = Table::new([
+        "gauge",
+        "x (m)",
+        "reference (m)",
+        "model (m)",
+        "model - ref (mm)",
+        "drift (mm/10 s)",
+        "glass walls (mm)",
+    ]);
+    for (g, gauge) in case.observations.gauges.iter().enumerate() {
+        let x = gauge.position_m[0];
+        let want = reference.level_m(x);
+        let now = mean_level(history, g, end - WINDOW_S, end);
+        let before = mean_level(history, g, end - 2.0 * WINDOW_S, end - WINDOW_S);
+        let or_dash = |v: Option<String>| v.unwrap_or_else(|| "-".to_string());
+        table.row([
+            gauge.name.clone(),
+            format!("{x:.2}"),
+            format!("{want:.4}"),
+            or_dash(now.map(|v| format!("{v:.4}"))),
+            or_dash(now.map(|v| format!("{:+.1}", 1e3 * (v - want)))),
+            or_dash(
+                now.zip(before)
+                    .map(|(a, b)| format!("{:+.1}", 1e3 * (a - b))),
+            ),
+            format!("{:+.1}", 1e3 * (glass.level_m(x) - want)),
+        ]);
+    }
+    print!("{table}");
+}
+
+fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
+    let (Some((last, _)), Some((first, _))) = (history.last(), at(history, r.until_s - WINDOW_S))
+    else {
+        return;
+    };
+    let dp = case.numerics.dp_m;
+    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
+    let span = last.t - first.t;
+    if span <= 0.0 {
+        return;
+    }
+    let d = |a: u64, b: u64| a as f64 - b as f64;
+    // A parked particle left over the weir, reached the collector (sediment) or was excluded;
+    // the inlet takes its particles from the parked ones.
+    let injected = d(last.injected, first.injected);
+    let over_weir = d(last.parked, first.parked) + injected
+        - d(last.eroded, first.eroded)
+        - d(last.excluded, first.excluded);
+    let to_m3_per_h = |n: f64| n * dp * dp * width / span * 3600.0;
+    println!(
+        "over the last {span:.0} s: inflow placed {:.3} m3/h, over the weir {:.3} m3/h \
+         ({:+.1} % of the {} m3/h asked), {} excluded",
+        to_m3_per_h(injected),
+        to_m3_per_h(over_weir),
+        100.0 * (to_m3_per_h(over_weir) / r.m3_per_h - 1.0),
+        r.m3_per_h,
+        d(last.excluded, first.excluded)
+    );
+}
+
+/// The cushion under the flow and the held bed's push, column by column, at the run's end.
+fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
+    let particles = sim.read_particles()?;
+    // Particles come in id order, as the region words do.
+    let regions = sim.regions()?;
+    let held = |i: usize| {
+        regions
+            .get(i)
+            .is_some_and(|&w| ParticleRegion::from_word(w).held)
+    };
+    let dp = case.numerics.dp_m;
+    let derived = sim.derived();
+    let Some((sediment, water)) = case.sediment_phases() else {
+        return Ok(());
+    };
+    let (sand, water) = (sediment as u32 + 1, water as u32 + 1);
+    let sand_there = (0..particles.len()).any(|i| particles.phase(i) == sand);
+    // The bed is the held sand, or the wall block that stands in for it.
+    let in_bed = |i: usize| {
+        if sand_there {
+            particles.phase(i) == sand && held(i)
+        } else {
+            particles.phase(i) == 0
+        }
+    };
+    let rho_w = derived.phases[water as usize].rho0;
+    let g = case.gravity_magnitude();
+    let mut table = Table::new([
+        "x (m)",
+        "bed top (m)",
+        "water p5 - bed (dp)",
+        "surface (m)",
+        "bed p / water weight",
+    ]);
+    let (mut gaps, mut ratios) = (Vec::new(), Vec::new());
+    for k in 0..18 {
+        let (x0, x1) = (0.3 + 0.1 * k as f64, 0.4 + 0.1 * k as f64);
+        let inside = |i: usize| {
+            let x = f64::from(particles.positions[i][0]);
+            x >= x0 && x < x1
+        };
+        let y = |i: usize| f64::from(particles.positions[i][1]);
+        let top = (0..particles.len())
+            .filter(|&i| inside(i) && in_bed(i) && y(i) < 0.15)
+            .max_by(|&a, &b| y(a).total_cmp(&y(b)));
+        let mut heights: Vec<f64> = (0..particles.len())
+            .filter(|&i| inside(i) && particles.phase(i) == water)
+            .map(y)
+            .collect();
+        let Some(top) = top else { continue };
+        if heights.is_empty() {
+            table.row([
+                format!("{x0:.1}"),
+                format!("{:.4}", y(top)),
+                "dry".into(),
+                "-".into(),
+                "-".into(),
+            ]);
+            continue;
+        }
+        heights.sort_by(f64::total_cmp);
+        let p5 = heights[(heights.len() as f64 * 0.05) as usize];
+        let surface = heights[heights.len() - 1] + 0.5 * dp;
+        let gap = (p5 - y(top)) / dp;
+        gaps.push(gap);
+        let ratio = sand_there.then(|| {
+            let rho0 = derived.phases[sand as usize].rho0;
+            let b = derived.c0 * derived.c0 * rho0 / 7.0;
+            let rho = f64::from(particles.vel_rho[top][3]);
+            let p = b * ((rho / rho0).powi(7) - 1.0);
+            p / (rho_w * g * (surface - y(top)))
+        });
+        ratios.extend(ratio);
+        table.row([
+            format!("{x0:.1}"),
+            format!("{:.4}", y(top)),
+            format!("{gap:.2}"),
+            format!("{surface:.4}"),
+            ratio.map_or("-".to_string(), |r| format!("{r:.2}")),
+        ]);
+    }
+    print!("{table}");
+    let worst = gaps.iter().copied().fold(f64::NAN, f64::max);
+    println!(
+        "water over the bed: largest 5th-percentile gap {worst:.2} dp (the goal: at most 1.2 dp){}",
+        if ratios.is_empty() {
+            String::new()
+        } else {
+            let mut r = ratios.clone();
+            r.sort_by(f64::total_cmp);
+            format!(
+                "; the top sand's pressure over the water's weight: median {:.2} (goal 0.75-1.25)",
+                r[r.len() / 2]
+            )
+        }
+    );
+    Ok(())
+}
