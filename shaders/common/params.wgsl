@@ -78,7 +78,7 @@ struct SimParams {
     n_probes: u32,
     euler_every: u32,        // Verlet: an Euler step every this many steps
     clamp_pressure: u32,     // 1: no tension: fluid density floored at rest, pressure >= 0
-    pad1: u32,
+    boundary_mode: u32,      // 0: dynamic boundary particles, 1: generalised walls (Adami 2012)
     pad2: u32,
     phases: array<Phase, 4>,
     tait_b: vec4<f32>,       // c0^2 rho0 / 7 per phase
@@ -87,3 +87,17 @@ struct SimParams {
 }
 
 @group(0) @binding(0) var<uniform> params: SimParams;
+
+// A wall's new density from its integrated `rho` and its force entry `f_w`: under the
+// generalised wall condition the force pass gives the density itself (physics/boundary.rs).
+// Walls never fall below rest (integrate.rs, wall_density).
+fn wall_density(rho: f32, f_w: f32, phase: u32) -> f32 {
+    let r = select(rho, f_w, params.boundary_mode == 1u);
+    return max(r, params.phases[phase].rho0);
+}
+
+// An inlet buffer particle's density: the one it entered with, or under the generalised wall
+// condition its own by continuity, without tension (cpu/store.rs, inlet_density).
+fn inlet_density(entered: f32, integrated: f32, phase: u32) -> f32 {
+    return select(entered, max(integrated, params.phases[phase].rho0), params.boundary_mode == 1u);
+}

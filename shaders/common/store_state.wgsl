@@ -87,9 +87,10 @@ fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: ve
             // from the wall behind it would otherwise thin out until the next one enters.
             let u = vec3<f32>(f.inlet_u, 0.0, 0.0);
             let moved = p.xyz + state.dt * u;
+            let r = inlet_density(vr.w, rho, phase);
             positions_out[i] = vec4<f32>(moved, p.w);
-            vel_rho_out[i] = vec4<f32>(u, vr.w);
-            check_health(moved, u, vr.w, ph.rho0);
+            vel_rho_out[i] = vec4<f32>(u, r);
+            check_health(moved, u, r, ph.rho0);
             return;
         }
         if (phase == f.water_phase && in_duct(p.xyz)) {

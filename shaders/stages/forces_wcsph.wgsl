@@ -2,7 +2,9 @@
 // continuity with density diffusion (Molteni & Colagrossi 2009; hydrostatic correction of
 // Fourtakas et al. 2019), pressure gradient, artificial (Monaghan 1992) or laminar (Morris et
 // al. 1997) viscosity or the divergence of the viscous stress of the rheology pass (multiphase,
-// Eq. 10 with sigma = -p I + tau), gravity; DBC walls (Crespo et al. 2007) only gather density.
+// Eq. 10 with sigma = -p I + tau), gravity; DBC walls (Crespo et al. 2007) only gather density,
+// or under the generalised wall condition (Adami et al. 2012) the fluid's pressure around them,
+// and get the density that gives it in place of a rate.
 // Also the per-particle stable step of the variable time step, min-reduced into `state`.
 // Reference: solver/src/physics/interaction.rs.
 
@@ -15,6 +17,8 @@
 @group(0) @binding(7) var stress_b: texture_2d<f32>;
 
 const VISCOSITY_MULTIPHASE: u32 = 2u;
+// Mirrors BOUNDARY_GENERALISED of gpu/params.rs.
+const BOUNDARY_GENERALISED: u32 = 1u;
 
 // The pressure of the momentum equation: Tait's, without tension when the case says so.
 fn momentum_pressure(rho: f32, phase: u32) -> f32 {
@@ -64,6 +68,11 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     var acc = vec3<f32>(0.0);
     var drho = 0.0;
     var visc_max = 0.0;
+    // A wall's sums of the generalised wall condition (physics/boundary.rs).
+    let generalised = params.boundary_mode == BOUNDARY_GENERALISED;
+    var wall_w = 0.0;
+    var wall_pw = 0.0;
+    var wall_rho_r = vec3<f32>(0.0);
     let cell = cell_coords(pos_i.xyz);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
@@ -93,6 +102,12 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
             let vdotr = dot(dv, dx);
             drho += m_j * vdotr * f;
             if (!mobile_i) {
+                if (generalised && !velocity_imposed(pos_j.xyz, phase_j)) {
+                    let w = kernel_w(sqrt(r2));
+                    wall_w += w;
+                    wall_pw += momentum_pressure(vr_j.w, phase_j) * w;
+                    wall_rho_r += vr_j.w * dx * w;
+                }
                 continue;
             }
             if (params.diffusion_mode != 0u && mobile_j && phase_j == phase_i) {
@@ -149,6 +164,14 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     } else {
         acc = vec3<f32>(0.0);
+        if (generalised) {
+            // The wall's density in place of its rate: that of the fluid's pressure around it.
+            drho = rho0_i;
+            if (wall_w > 0.0) {
+                let p = (wall_pw + dot(params.gravity.xyz, wall_rho_r)) / wall_w;
+                drho = rho0_i * pow(max(1.0 + p / b_i, 0.0), 1.0 / 7.0);
+            }
+        }
     }
     forces[i] = vec4<f32>(acc, drho);
     if (REDUCE_DT) {

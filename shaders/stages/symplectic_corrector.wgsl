@@ -31,7 +31,10 @@ fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     let phase = bitcast<u32>(p.w);
     let ph = params.phases[phase];
     let eps = -(f.w / textureLoad(vel_rho_half, texel(i), 0).w) * dt;
-    let rho = vr.w * (2.0 - eps) / (2.0 + eps);
+    var rho = vr.w * (2.0 - eps) / (2.0 + eps);
+    if (ph.mobile < 0.5) {
+        rho = wall_density(rho, f.w, phase);
+    }
     ids_out[i] = ids_n[i];
     let v = vr.xyz + dt * f.xyz;
     store_state(i, ids_n[i], p, vr, p.xyz + dt * 0.5 * (vr.xyz + v), v, rho, ph);

@@ -36,7 +36,7 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
         // The inlet buffer moves at the inlet velocity, at its density (store_state.wgsl).
         let u = vec3<f32>(fl.inlet_u, 0.0, 0.0);
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * u, p.w));
-        textureStore(vel_rho_half, texel(i), vec4<f32>(u, vr.w));
+        textureStore(vel_rho_half, texel(i), vec4<f32>(u, inlet_density(vr.w, rho, phase)));
     } else if (params.phases[phase].mobile > 0.5 && (regions[ids_n[i]] & REGION_HELD_BIT) != 0u) {
         textureStore(positions_half, texel(i), p);
         textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, rho));
@@ -46,6 +46,6 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
         textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz + half_dt * f.xyz, r));
     } else {
         textureStore(positions_half, texel(i), p);
-        textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz, max(rho, params.phases[phase].rho0)));
+        textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz, wall_density(rho, f.w, phase)));
     }
 }

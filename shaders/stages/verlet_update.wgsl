@@ -42,7 +42,10 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
         base = vr;
         span = dt;
     }
-    let rho = base.w + span * f.w;
+    var rho = base.w + span * f.w;
+    if (ph.mobile < 0.5) {
+        rho = wall_density(rho, f.w, phase);
+    }
     ids_out[i] = ids_n[i];
     // Held sediment is at rest in both interleaved sequences: a particle held at n and
     // released at n + 1 must not take back the velocity it had at n - 1.

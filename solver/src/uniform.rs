@@ -2,7 +2,9 @@
 //! the sediment model and the open flume. The CPU backend reads the same block, and the
 //! sediment model of `physics` that both are tested against comes from the same case here.
 
-use crate::config::{Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion};
+use crate::config::{
+    BoundaryMethod, Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion,
+};
 use crate::derived::{self, Derived};
 use crate::gpu::params::*;
 use crate::health::{RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
@@ -92,7 +94,11 @@ pub fn sim_params(
             Integrator::Symplectic => 1,
         },
         clamp_pressure: u32::from(case.numerics.clamp_negative_pressure),
-        pad: [0; 2],
+        boundary_mode: match case.numerics.boundary {
+            BoundaryMethod::Dynamic => BOUNDARY_DYNAMIC,
+            BoundaryMethod::Generalised => BOUNDARY_GENERALISED,
+        },
+        pad: 0,
         phases,
         tait_b,
         sediment: sediment_params(case, derived),

@@ -30,6 +30,17 @@ fn forces_with_molteni_diffusion_match_the_interaction() {
 }
 
 #[test]
+fn generalised_wall_densities_match_the_interaction() {
+    stages::check_generalised_wall_forces(&CPU);
+}
+
+#[test]
+fn steps_under_generalised_walls_match_the_oracle() {
+    stages::check_symplectic_step_generalised(&CPU);
+    stages::check_verlet_steps_generalised(&CPU);
+}
+
+#[test]
 fn laminar_forces_match_the_interaction() {
     stages::check_laminar_forces(&CPU);
 }

@@ -34,6 +34,19 @@ fn forces_wcsph_molteni_diffusion_matches_the_cpu_interaction() {
 }
 
 #[test]
+fn forces_wcsph_generalised_walls_match_the_cpu_interaction() {
+    on_gpu(stages::check_generalised_wall_forces);
+}
+
+#[test]
+fn steps_under_generalised_walls_match_the_cpu_steps() {
+    on_gpu(|b| {
+        stages::check_symplectic_step_generalised(b);
+        stages::check_verlet_steps_generalised(b);
+    });
+}
+
+#[test]
 fn forces_wcsph_laminar_matches_the_cpu_interaction() {
     on_gpu(stages::check_laminar_forces);
 }

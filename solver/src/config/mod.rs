@@ -260,6 +260,21 @@ pub struct Numerics {
     /// sustain that tension anyway. Off by default.
     #[serde(default)]
     pub clamp_negative_pressure: bool,
+    /// How walls and held sediment push back on the fluid; dynamic (DBC) when omitted.
+    #[serde(default)]
+    pub boundary: BoundaryMethod,
+}
+
+/// The boundary condition of walls and held (un-yielded) sediment.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, rename_all = "snake_case", tag = "method")]
+pub enum BoundaryMethod {
+    /// Dynamic boundary particles (Crespo et al. 2007): density from the continuity equation.
+    #[default]
+    Dynamic,
+    /// The generalised wall condition of Adami, Hu & Adams (2012): each boundary particle takes
+    /// the pressure of the fluid around it plus the hydrostatic term (`physics::boundary`).
+    Generalised,
 }
 
 /// Time integration scheme (both as in DualSPHysics).

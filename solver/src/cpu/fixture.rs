@@ -39,6 +39,7 @@ fn params(viscosity: Viscosity) -> Params {
         mass: rho0 * DP * DP,
         mu,
         mobile,
+        generalised_wall: false,
     };
     Params {
         dim: 2,
@@ -49,6 +50,7 @@ fn params(viscosity: Viscosity) -> Params {
         delta: 0.1,
         viscosity,
         clamp_negative_pressure: false,
+        generalised_walls: false,
         cfl: 0.2,
         phases: vec![
             phase(1000.0, 0.0, false),

@@ -82,10 +82,12 @@ impl CpuEngine {
             (0..active)
                 .into_par_iter()
                 .map(|i| {
-                    (
-                        model.side(&pos[i], &vel[i]),
-                        store.velocity_imposed(&pos[i]),
-                    )
+                    let imposed = store.velocity_imposed(&pos[i]);
+                    let side = Side {
+                        imposed,
+                        ..model.side(&pos[i], &vel[i])
+                    };
+                    (side, imposed)
                 })
                 .unzip()
         });

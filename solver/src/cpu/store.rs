@@ -3,7 +3,7 @@
 //! and in an open flume the outlet, the collector, the inlet buffer, a bottom outlet's duct,
 //! the parked reservoir and the exclusion of a particle whose density left the range.
 
-use crate::gpu::params::{ExcludedParticle, FlumeGpu, SimParams};
+use crate::gpu::params::{BOUNDARY_GENERALISED, ExcludedParticle, FlumeGpu, SimParams};
 use crate::health::Health;
 use crate::physics::integrate::Particle;
 use crate::physics::{Params, Phase};
@@ -73,6 +73,19 @@ impl<'a> Store<'a> {
         self.flume.is_some_and(|f| x[3].to_bits() == f.parked_phase)
     }
 
+    /// An inlet buffer particle's density: the one it entered with, or under the generalised
+    /// wall condition its own by continuity (`integrated`, no tension): at rest density the
+    /// buffer pushes on the water it meets with no pressure, and the water it squeezes out ran
+    /// into the apron under it and through it (`physics::boundary`). Mirrors `inlet_density`
+    /// in params.wgsl.
+    fn inlet_density(&self, phase: &Phase, entered: f32, integrated: f32) -> f32 {
+        if self.params.boundary_mode == BOUNDARY_GENERALISED {
+            integrated.max(phase.rho0)
+        } else {
+            entered
+        }
+    }
+
     fn clamped(&self, phase: &Phase, rho: f32) -> f32 {
         if self.clamp { rho.max(phase.rho0) } else { rho }
     }
@@ -94,7 +107,8 @@ impl<'a> Store<'a> {
             }
             if p[3].to_bits() == f.water_phase && Self::in_inlet(f, p) {
                 let moved = [p[0] + half_dt * f.inlet_u, p[1], p[2], p[3]];
-                return (moved, [f.inlet_u, 0.0, 0.0, vr[3]]);
+                let rho = self.inlet_density(phase, vr[3], free.1[3]);
+                return (moved, [f.inlet_u, 0.0, 0.0, rho]);
             }
         }
         let (x, mut v) = free;
@@ -136,11 +150,12 @@ impl<'a> Store<'a> {
                 return self.park(f, id, true);
             }
             if kind == f.water_phase && Self::in_inlet(f, p) {
-                // Imposed velocity, at the density it entered with.
+                // Imposed velocity, at the density it entered with (or its own, see below).
+                let rho = self.inlet_density(phase, vr[3], v[3]);
                 return self.checked(
                     phase,
                     [p[0] + dt * f.inlet_u, p[1], p[2], p[3]],
-                    [f.inlet_u, 0.0, 0.0, vr[3]],
+                    [f.inlet_u, 0.0, 0.0, rho],
                 );
             }
             if kind == f.water_phase && Self::in_duct(f, p) {

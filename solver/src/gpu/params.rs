@@ -91,7 +91,8 @@ pub struct SimParams {
     pub n_probes: u32,
     pub euler_every: u32,
     pub clamp_pressure: u32,
-    pub pad: [u32; 2],
+    pub boundary_mode: u32,
+    pub pad: u32,
     pub phases: [PhaseParams; MAX_PHASES],
     pub tait_b: [f32; 4],
     pub sediment: SedimentGpu,
@@ -101,6 +102,8 @@ pub struct SimParams {
 pub const VISCOSITY_ARTIFICIAL: u32 = 0;
 pub const VISCOSITY_LAMINAR: u32 = 1;
 pub const VISCOSITY_MULTIPHASE: u32 = 2;
+pub const BOUNDARY_DYNAMIC: u32 = 0;
+pub const BOUNDARY_GENERALISED: u32 = 1;
 pub const DIFFUSION_NONE: u32 = 0;
 pub const DIFFUSION_MOLTENI: u32 = 1;
 pub const DIFFUSION_FOURTAKAS: u32 = 2;
@@ -231,6 +234,7 @@ impl SimParams {
             delta: self.delta_h_c0 / (self.h * self.c0),
             hydrostatic_diffusion: self.diffusion_mode == DIFFUSION_FOURTAKAS,
             clamp_negative_pressure: self.clamp_pressure != 0,
+            generalised_walls: self.boundary_mode == BOUNDARY_GENERALISED,
             viscosity: match self.viscosity_mode {
                 VISCOSITY_ARTIFICIAL => Viscosity::Artificial { alpha: self.alpha },
                 VISCOSITY_LAMINAR => Viscosity::Laminar,
@@ -244,6 +248,8 @@ impl SimParams {
                     mass: ph.mass,
                     mu: ph.mu,
                     mobile: ph.mobile > 0.5,
+                    generalised_wall: ph.mobile <= 0.5
+                        && self.boundary_mode == BOUNDARY_GENERALISED,
                 })
                 .collect(),
         }

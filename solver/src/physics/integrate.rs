@@ -5,10 +5,18 @@
 //! `eps = -(d rho/dt / rho)_half dt`, which is exact for a constant d rho/dt.
 //!
 //! DBC walls (Crespo et al. 2007) never move and keep `rho >= rho0`, so a wall never sucks fluid
-//! towards itself with negative pressure.
+//! towards itself with negative pressure; under the generalised wall condition a wall's density
+//! is the one its force pass gave (`physics::boundary`), kept at or above rest as well.
 
 use super::Phase;
 use super::interaction::phase_index;
+
+/// A wall's new density: under the generalised wall condition the one its forces `f` carry,
+/// else the integrated `rho`; never below rest either way.
+fn wall_density(phase: &Phase, rho: f32, f: &[f32; 4]) -> f32 {
+    let rho = if phase.generalised_wall { f[3] } else { rho };
+    rho.max(phase.rho0)
+}
 
 /// One particle's predictor half step: its position and velocity-density at t + dt/2 from
 /// those at t and its forces `f` at t. A wall keeps its position and velocity, and
@@ -17,7 +25,7 @@ pub fn predict(phase: &Phase, dt: f32, x: &[f32; 4], v: &[f32; 4], f: &[f32; 4])
     let half = 0.5 * dt;
     let rho = v[3] + half * f[3];
     if !phase.mobile {
-        return (*x, [v[0], v[1], v[2], rho.max(phase.rho0)]);
+        return (*x, [v[0], v[1], v[2], wall_density(phase, rho, f)]);
     }
     (
         [
@@ -48,7 +56,7 @@ pub fn correct(
     let eps = -(f[3] / rho_half) * dt;
     let rho = v[3] * (2.0 - eps) / (2.0 + eps);
     if !phase.mobile {
-        return (*x, [v[0], v[1], v[2], rho.max(phase.rho0)]);
+        return (*x, [v[0], v[1], v[2], wall_density(phase, rho, f)]);
     }
     let v_new = [v[0] + dt * f[0], v[1] + dt * f[1], v[2] + dt * f[2]];
     let step = dt * 0.5;
@@ -83,7 +91,7 @@ pub fn verlet_step(
     };
     let rho = from[3] + span * f[3];
     if !phase.mobile {
-        return (*x, [v[0], v[1], v[2], rho.max(phase.rho0)]);
+        return (*x, [v[0], v[1], v[2], wall_density(phase, rho, f)]);
     }
     let half_dt2 = 0.5 * dt * dt;
     (
@@ -249,12 +257,14 @@ mod tests {
                 mass: 0.1,
                 mu: 1e-3,
                 mobile: true,
+                generalised_wall: false,
             },
             Phase {
                 rho0: 1000.0,
                 mass: 0.1,
                 mu: 0.0,
                 mobile: false,
+                generalised_wall: false,
             },
         ]
     }
@@ -269,6 +279,7 @@ mod tests {
             delta: 0.1,
             hydrostatic_diffusion: true,
             clamp_negative_pressure: false,
+            generalised_walls: false,
             viscosity: Viscosity::Artificial { alpha: 0.01 },
             cfl: 0.2,
             phases: phases(),
@@ -354,6 +365,7 @@ mod tests {
             mass: 1.0,
             mu: 0.0,
             mobile: true,
+            generalised_wall: false,
         }];
         let g = -9.81f32;
         let dt = 1e-3f32;

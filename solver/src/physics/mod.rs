@@ -13,6 +13,7 @@
 //! In 2-D the plane is (x, y) with y vertical and z = 0; in 3-D z is vertical. The vertical axis is
 //! index `dim - 1`.
 
+pub mod boundary;
 pub mod eos;
 pub mod integrate;
 pub mod interaction;
@@ -33,6 +34,9 @@ pub struct Phase {
     pub mu: f32,
     /// `false` for dynamic boundary (DBC) wall particles: they carry a density but never move.
     pub mobile: bool,
+    /// A wall under the generalised wall condition: its density is the one the force pass
+    /// gives it ([`boundary`]), stored as it is rather than integrated from a rate.
+    pub generalised_wall: bool,
 }
 
 /// Viscosity model of the momentum equation.
@@ -70,6 +74,9 @@ pub struct Params {
     pub clamp_negative_pressure: bool,
     /// Courant number C_CFL (dimensionless, typically 0.2).
     pub cfl: f32,
+    /// Walls and held sediment by the generalised wall condition ([`boundary`]) instead of
+    /// dynamic boundary particles.
+    pub generalised_walls: bool,
     /// Phase table, indexed by the phase bits of the positions.
     pub phases: Vec<Phase>,
 }

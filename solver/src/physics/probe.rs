@@ -113,6 +113,7 @@ mod tests {
             delta: 0.1,
             hydrostatic_diffusion: true,
             clamp_negative_pressure: false,
+            generalised_walls: false,
             viscosity: Viscosity::Artificial { alpha: 0.01 },
             cfl: 0.2,
             phases: vec![
@@ -121,12 +122,14 @@ mod tests {
                     mass,
                     mu: 1e-3,
                     mobile: true,
+                    generalised_wall: false,
                 },
                 Phase {
                     rho0: 1000.0,
                     mass,
                     mu: 0.0,
                     mobile: false,
+                    generalised_wall: false,
                 },
             ],
         }

@@ -49,6 +49,7 @@ mod tests {
             delta: 0.1,
             hydrostatic_diffusion: true,
             clamp_negative_pressure: false,
+            generalised_walls: false,
             viscosity: Viscosity::Laminar,
             cfl: 0.2,
             phases,
@@ -61,6 +62,7 @@ mod tests {
             mass: 1.0,
             mu,
             mobile,
+            generalised_wall: false,
         }
     }
 

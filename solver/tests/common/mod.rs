@@ -82,6 +82,8 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
         delta,
         hydrostatic_diffusion,
         clamp_negative_pressure: case.numerics.clamp_negative_pressure,
+        generalised_walls: case.numerics.boundary
+            == flume_solver::config::BoundaryMethod::Generalised,
         viscosity: match case.numerics.viscosity {
             CaseViscosity::Artificial { alpha } => Viscosity::Artificial {
                 alpha: alpha as f32,
@@ -100,6 +102,8 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
                 mass: ph.mass as f32,
                 mu: ph.viscosity_pa_s as f32,
                 mobile: ph.mobile,
+                generalised_wall: !ph.mobile
+                    && case.numerics.boundary == flume_solver::config::BoundaryMethod::Generalised,
             })
             .collect(),
     }

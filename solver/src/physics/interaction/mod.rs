@@ -5,11 +5,13 @@
 //! - momentum, Eq. 10 with sigma = -p I, plus Monaghan (1992) artificial viscosity in the
 //!   DualSPHysics form or Morris et al. (1997) laminar viscosity;
 //! - dynamic boundary (DBC) walls of Crespo et al. (2007): wall particles get a density rate from
-//!   the fluid around them and nothing else.
+//!   the fluid around them and nothing else; or, under the generalised wall condition of Adami
+//!   et al. (2012, `physics::boundary`), the density of the fluid's pressure around them.
 //!
 //! The GPU visits neighbours through a cell list; both must give the same sums (up to summation
 //! order), so this file is the specification of what each pair contributes.
 
+use super::boundary::{WallSums, density};
 use super::eos::{pressure, tait_b};
 use super::kernel::Wendland;
 use super::lanes::{Lanes, Mask, Real, pack};
@@ -68,6 +70,9 @@ pub struct Side<L: Real = f32> {
     pub mu: L,
     /// `rho0 g / B` of the phase, 1/m (see [`PhaseConsts::hydro`]).
     pub hydro: L,
+    /// Moved at an imposed velocity (an inlet buffer): its density is not the flow's, and a
+    /// wall under the generalised condition does not count it (`physics::boundary`).
+    pub imposed: bool,
 }
 
 impl Side<Lanes> {
@@ -127,6 +132,8 @@ pub struct PairSum<L: Real = f32> {
     pub drho: L,
     /// Largest `|h v_ij . x_ij / (r^2 + eta^2)|` over the pairs, m/s (the viscous step bound).
     pub visc_max: L,
+    /// A wall's sums of the generalised wall condition.
+    pub wall: WallSums<L>,
 }
 
 impl PairSum<Lanes> {
@@ -137,6 +144,11 @@ impl PairSum<Lanes> {
             acc: self.acc.map(|a| a.0[k]),
             drho: self.drho.0[k],
             visc_max: self.visc_max.0[k],
+            wall: WallSums {
+                w: self.wall.w.0[k],
+                p_w: self.wall.p_w.0[k],
+                rho_r_w: self.wall.rho_r_w.map(|x| x.0[k]),
+            },
         }
     }
 }
@@ -218,6 +230,7 @@ impl<'a> PairModel<'a> {
             mass: ph.mass,
             mu: ph.mu,
             hydro: ph.hydro,
+            imposed: false,
         }
     }
 
@@ -261,6 +274,15 @@ impl<'a> PairModel<'a> {
         };
         let v_ij = [i.v[0] - s(j.v[0]), i.v[1] - s(j.v[1]), i.v[2] - s(j.v[2])];
         let vdotr = dot3(v_ij, x_ij);
+        if params.generalised_walls && !j.imposed {
+            // A wall gathers the pressure of the fluid around it (j is fluid: two walls are out).
+            let wall = near & !i.mobile;
+            if wall.any() {
+                let p_j = j.p_over_rho2 * j.rho * j.rho;
+                sum.wall
+                    .add(wall, self.kernel.w(r2.sqrt()), s(p_j), s(j.rho), x_ij);
+            }
+        }
         // Continuity, Eq. 9: v_ij . grad_i W_ij = vdotr F.
         sum.drho = L::select(near, sum.drho + m_j * vdotr * f, sum.drho);
         let near = near & i.mobile;
@@ -327,7 +349,16 @@ impl<'a> PairModel<'a> {
     pub fn finish(&self, i: &Side, sum: &PairSum, force_bound: bool) -> ([f32; 4], f32) {
         let params = self.params;
         if !i.mobile {
-            return ([0.0, 0.0, 0.0, sum.drho], f32::INFINITY);
+            // Under the generalised condition a wall's fourth entry is its density, not a rate.
+            let rho_or_rate = if params.generalised_walls {
+                let ph = self.phase(i.phase);
+                sum.wall
+                    .pressure(params.gravity)
+                    .map_or(ph.rho0, |p| density(p, ph.rho0, ph.b))
+            } else {
+                sum.drho
+            };
+            return ([0.0, 0.0, 0.0, rho_or_rate], f32::INFINITY);
         }
         let mut acc = sum.acc;
         for (a, g) in acc.iter_mut().zip(params.gravity) {

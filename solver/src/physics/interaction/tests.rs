@@ -17,6 +17,7 @@ fn water(mass: f32) -> Phase {
         mass,
         mu: 1e-3,
         mobile: true,
+        generalised_wall: false,
     }
 }
 
@@ -26,6 +27,7 @@ fn wall(mass: f32) -> Phase {
         mass,
         mu: 0.0,
         mobile: false,
+        generalised_wall: false,
     }
 }
 
@@ -38,6 +40,7 @@ fn params_2d(h: f32, c0: f32, mass: f32) -> Params {
         delta: 0.0,
         hydrostatic_diffusion: true,
         clamp_negative_pressure: false,
+        generalised_walls: false,
         viscosity: Viscosity::Artificial { alpha: 0.0 },
         cfl: 0.2,
         phases: vec![water(mass), wall(mass)],
