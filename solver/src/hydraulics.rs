@@ -332,5 +332,52 @@ impl Channel {
     }
 }
 
+/// The overrides (`Case::from_path_with`) that make `case`'s flume a clear-water one: its
+/// sediment blocks become wall blocks of the same shape, and the collector pit starts full of
+/// water (a case needs some fluid, and the pit fills before any water leaves over the weir).
+pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
+    let channel = Channel::from_case(case)?;
+    let water = case
+        .phases
+        .iter()
+        .find(|p| p.sediment.is_none())
+        .ok_or_else(|| format!("{}: a clear-water flume needs a water phase", case.name))?;
+    let is_bed = |phase: &str| {
+        case.phases
+            .iter()
+            .any(|p| p.name == phase && p.sediment.is_some())
+    };
+    let block = |min: &[f64], max: &[f64]| format!("{{min_m: {min:?}, max_m: {max:?}}}");
+    let walls: Vec<String> = case
+        .walls
+        .blocks
+        .iter()
+        .map(|w| block(&w.min_m, &w.max_m))
+        .chain(
+            case.fluid_blocks
+                .iter()
+                .filter(|b| is_bed(&b.phase))
+                .map(|b| block(&b.min_m, &b.max_m)),
+        )
+        .collect();
+    let pit = [channel.x_bed_end_m, channel.weir.floor_m];
+    let crest = [channel.weir.x_m, channel.weir.crest_m];
+    let fluids: Vec<String> = case
+        .fluid_blocks
+        .iter()
+        .filter(|b| !is_bed(&b.phase))
+        .map(|b| format!("{{phase: {}, {}", b.phase, &block(&b.min_m, &b.max_m)[1..]))
+        .chain([format!(
+            "{{phase: {}, {}",
+            water.name,
+            &block(&pit, &crest)[1..]
+        )])
+        .collect();
+    Ok(vec![
+        format!("walls.blocks=[{}]", walls.join(", ")),
+        format!("fluid_blocks=[{}]", fluids.join(", ")),
+    ])
+}
+
 #[cfg(test)]
 mod tests;

@@ -18,7 +18,7 @@
 
 use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
-use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, SideWalls};
+use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, SideWalls, fixed_bed_overrides};
 use flume_solver::{Backend, Case, Observations, ParticleRegion, Simulation};
 use std::path::Path;
 use std::time::Instant;
@@ -69,10 +69,8 @@ pub fn run(flume: &Path, set: &[String], runs: &[LevelRun]) -> Result<()> {
 
 /// The flume at `r`'s resolution and discharge, with a reservoir large enough for the water it
 /// stores, and its bed made wall when asked: the case file with overrides, validated as
-/// `--set` is.
-/// The reference is the sand bed's as generated at that dp, a fixed bed's too.
+/// `--set` is. The reference is the sand bed's as generated at that dp, a fixed bed's too.
 fn level_case(flume: &Path, set: &[String], r: &LevelRun) -> Result<(Case, Channel)> {
-    let base = Case::from_path_with(flume, set).context("the flume case was refused")?;
     let mut overrides = set.to_vec();
     overrides.extend([
         format!("numerics.dp_m={}", r.dp_m),
@@ -89,56 +87,9 @@ fn level_case(flume: &Path, set: &[String], r: &LevelRun) -> Result<(Case, Chann
     if !r.fixed_bed {
         return Ok((sand, channel));
     }
-    {
-        let sediment: Vec<&str> = base
-            .phases
-            .iter()
-            .filter(|p| p.sediment.is_some())
-            .map(|p| p.name.as_str())
-            .collect();
-        let (beds, fluids): (Vec<_>, Vec<_>) = base
-            .fluid_blocks
-            .iter()
-            .partition(|b| sediment.contains(&b.phase.as_str()));
-        let block = |min: &[f64], max: &[f64]| format!("{{min_m: {min:?}, max_m: {max:?}}}");
-        let walls: Vec<String> = base
-            .walls
-            .blocks
-            .iter()
-            .map(|w| block(&w.min_m, &w.max_m))
-            .chain(beds.iter().map(|b| block(&b.min_m, &b.max_m)))
-            .collect();
-        let mut fluids: Vec<String> = fluids
-            .iter()
-            .map(|b| {
-                format!(
-                    "{{phase: {}, min_m: {:?}, max_m: {:?}}}",
-                    b.phase, b.min_m, b.max_m
-                )
-            })
-            .collect();
-        // A case needs some fluid to start with: the collector pit full of water, which it
-        // would be before any water left over the weir.
-        let (channel, water) = (
-            Channel::from_case(&base).map_err(anyhow::Error::msg)?,
-            base.phases
-                .iter()
-                .find(|p| p.sediment.is_none())
-                .context("a water phase")?,
-        );
-        fluids.push(format!(
-            "{{phase: {}, min_m: [{}, {}], max_m: [{}, {}]}}",
-            water.name,
-            channel.x_bed_end_m,
-            channel.weir.floor_m,
-            channel.weir.x_m,
-            channel.weir.crest_m
-        ));
-        overrides.push(format!("walls.blocks=[{}]", walls.join(", ")));
-        overrides.push(format!("fluid_blocks=[{}]", fluids.join(", ")));
-    }
+    overrides.extend(fixed_bed_overrides(&sand).map_err(anyhow::Error::msg)?);
     let fixed = Case::from_path_with(flume, &overrides)
-        .with_context(|| format!("the flume at dp = {} m was refused", r.dp_m))?;
+        .with_context(|| format!("the fixed-bed flume at dp = {} m was refused", r.dp_m))?;
     Ok((fixed, channel))
 }
 
@@ -289,6 +240,17 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
         r.m3_per_h,
         d(last.excluded, first.excluded)
     );
+    let rho_s = case
+        .phases
+        .iter()
+        .find_map(|p| p.sediment.as_ref().map(|_| p.rho0_kg_per_m3))
+        .unwrap_or(0.0);
+    println!(
+        "eroded by t = {:.0} s: {} sand particles in the collector, {:.3} kg/m (Eq. 34)",
+        last.t,
+        last.eroded,
+        last.eroded as f64 * dp * dp * rho_s
+    );
 }
 
 /// The cushion under the flow and the held bed's push, column by column, at the run's end.
@@ -374,6 +336,12 @@ fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
     }
     print!("{table}");
     let worst = gaps.iter().copied().fold(f64::NAN, f64::max);
+    // Water can leave only over the weir: any below the floor went through a wall.
+    let floor = case.domain.min_m[1] - f64::from(case.walls.layers) * dp;
+    let lost = (0..particles.len())
+        .filter(|&i| particles.phase(i) == water && f64::from(particles.positions[i][1]) < floor)
+        .count();
+    println!("water particles below the floor's outer layer (through a wall): {lost}");
     println!(
         "water over the bed: largest 5th-percentile gap {worst:.2} dp (the goal: at most 1.2 dp){}",
         if ratios.is_empty() {

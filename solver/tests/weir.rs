@@ -1,0 +1,122 @@
+//! The ULBRA flume in clear water at CI size (dp = 1 cm, the sand bed made a fixed wall block,
+//! generalised walls), run at a constant 2 m3/h to a steady state and held against the weir's
+//! rating: the 1-D reference of `flume_solver::hydraulics` on the geometry as generated, fixed
+//! before this run was compared with it. The flow over the bed is two to three particles deep.
+//!
+//! What is checked, over t = 30-40 s (the flume fills in about 15 s):
+//! - the level at P3, 0.5 m before the pit, within 3 mm of the reference: the weir's control
+//!   (the case file's DBC walls hold it +9.7 mm high: `bench --levels --fixed-bed`);
+//! - the discharge over the weir within 2 % of the inflow: the flume has stopped storing;
+//! - no water through a wall (the leak of an inlet buffer counted in the walls' pressure).
+//!
+//! Not checked: P1 and P2, 1.5 and 0.75 m further upstream, which stand 7-11 mm over the
+//! reference with alpha = 0.02 (the artificial viscosity makes the slope; see the README's
+//! levels section).
+
+mod common;
+
+use common::case_path;
+use flume_solver::hydraulics::{Channel, fixed_bed_overrides};
+use flume_solver::{Backend, Case, Simulation};
+
+const WATER: u32 = 1;
+
+fn clear_water_ci() -> (Case, Channel) {
+    let path = case_path("../launch_configs/ulbra_flume.yaml");
+    let mut set = vec![
+        "numerics.dp_m=0.01".to_string(),
+        "open_flume.reservoir_particles=3000".to_string(),
+        "numerics.boundary={method: generalised}".to_string(),
+    ];
+    let sand = Case::from_path_with(&path, &set).expect("the CI flume");
+    let channel = Channel::as_generated(&sand).expect("a flume");
+    set.extend(fixed_bed_overrides(&sand).expect("a sand bed to fix"));
+    (
+        Case::from_path_with(&path, &set).expect("the clear-water flume"),
+        channel,
+    )
+}
+
+#[test]
+fn clear_water_flume_holds_the_weirs_level_and_passes_its_inflow() {
+    let (case, channel) = clear_water_ci();
+    let q = case.open_flume.as_ref().expect("flume").inflow_m3_per_s;
+    let width = case.open_flume.as_ref().expect("flume").width_m;
+    let p3_x = case.observations.gauges[2].position_m[0];
+    let want = channel.steady(q, width).level_m(p3_x);
+    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    sim.advance_to(30.0).expect("fills");
+    let books = |sim: &Simulation| {
+        let f = sim.flume().expect("flume");
+        (
+            f.parked_particles,
+            f.injected_particles,
+            f.excluded_particles,
+        )
+    };
+    let start = books(&sim);
+    let mut levels = Vec::new();
+    for t in 31..=40 {
+        sim.advance_to(f64::from(t)).expect("runs");
+        let obs = sim.observe().expect("observes");
+        levels.push(obs.gauges[2].level_m.expect("P3 wet"));
+    }
+    let end = books(&sim);
+    let p3 = levels.iter().sum::<f64>() / levels.len() as f64;
+    eprintln!("P3 {p3:.4} m against the reference's {want:.4} m");
+    assert!(
+        (p3 - want).abs() < 0.003,
+        "P3 at {p3:.4} m, the weir's rating gives {want:.4} m"
+    );
+    // Particles parked at the outlet over the 10 s, the inlet's drawn back from the parked.
+    let over_weir = (end.0 + end.1) as f64 - (start.0 + start.1) as f64 - (end.2 - start.2) as f64;
+    let dp = case.numerics.dp_m;
+    let outflow = over_weir * dp * dp * width / 10.0;
+    assert!(
+        (outflow / q - 1.0).abs() < 0.02,
+        "over the weir {outflow:.3e} m3/s against {q:.3e} m3/s in"
+    );
+    let particles = sim.read_particles().expect("readback");
+    let floor = -0.025;
+    let through = (0..particles.len())
+        .filter(|&i| particles.phase(i) == WATER && particles.positions[i][1] < floor)
+        .count();
+    assert_eq!(through, 0, "water below the floor's wall layers");
+}
+
+/// The wgpu stages of the generalised walls and of the inlet buffer's density (forces,
+/// integrators, the end of a step) against the CPU backend on the first 4 s of the same flume:
+/// the jet over the apron, where a buffer at rest density drove water through the walls. The
+/// level at P1 (wet from about 2 s) within a dp, and no water through a wall on either.
+#[test]
+fn the_cpu_and_wgpu_backends_agree_on_the_clear_water_flume() {
+    let _l = common::gpu_lock();
+    let Some(gpu) = common::gpu() else { return };
+    let (case, _) = clear_water_ci();
+    let run = |backend: Backend| {
+        let mut sim = Simulation::new(backend, &case).expect("builds");
+        let levels: Vec<Option<f64>> = (1..=4)
+            .map(|t| {
+                sim.advance_to(f64::from(t)).expect("runs");
+                sim.observe().expect("observes").gauges[0].level_m
+            })
+            .collect();
+        let particles = sim.read_particles().expect("readback");
+        let through = (0..particles.len())
+            .filter(|&i| particles.phase(i) == WATER && particles.positions[i][1] < -0.025)
+            .count();
+        (levels, through)
+    };
+    let (cpu, cpu_through) = run(Backend::Cpu { threads: 0 });
+    let (wgpu, wgpu_through) = run(Backend::from(gpu));
+    assert_eq!((cpu_through, wgpu_through), (0, 0), "water through a wall");
+    assert!(cpu[3].is_some(), "P1 dry at 4 s");
+    for (t, (a, b)) in cpu.iter().zip(&wgpu).enumerate() {
+        let (a, b) = (a.unwrap_or(0.0), b.unwrap_or(0.0));
+        assert!(
+            (a - b).abs() <= case.numerics.dp_m,
+            "t = {} s: P1 {a:.4} m on the CPU backend, {b:.4} m on wgpu",
+            t + 1
+        );
+    }
+}
