@@ -161,15 +161,16 @@ fn run(backend: Backend, end_s: u32) -> (Vec<Second>, f64) {
 const CPU: Backend = Backend::Cpu { threads: 0 };
 
 /// The bundled session's steady levels at 2 m3/h (`tests/data/ulbra_session.mcap`, made by
-/// `flume-twin make-session` from Manning's law with Strickler's n for ks = 3 d50 over the
-/// weir's critical depth): P2 0.0823 m, P3 0.0787 m, the mean of its samples from 10 s to 40 s
-/// to the 0.5 mm of its sensor noise.
-const SESSION_P2_M: f64 = 0.0823;
-const SESSION_P3_M: f64 = 0.0787;
+/// `flume-twin make-session` from the 1-D reference of `flume_solver::hydraulics`: the weir's
+/// rating, the drop into the pit, Manning's law with Strickler's n for ks = 3 d50): P2
+/// 0.0801 m, P3 0.0773 m, the mean of its samples from 10 s to 40 s to the 0.5 mm of its
+/// sensor noise.
+const SESSION_P2_M: f64 = 0.0801;
+const SESSION_P3_M: f64 = 0.0773;
 /// The twin's level against the session's from 3 s after the front passed P3 to 18 s: 1.5 dp.
 /// At dp = 1 cm the water over the bed is two to three particles deep and a gauge interpolates
 /// the surface between particles 1 cm apart; the session's levels come from a 1-D friction law,
-/// not from this model. The twin's levels are still rising at 18 s (0.7 cm above the session
+/// not from this model. The twin's levels are still rising at 18 s (0.9 cm above the session
 /// at P2 then); they settle 2 to 2.5 cm above it by 40 s (node/tests/whole_session.rs), the
 /// water riding about a particle above the held bed and the weir's crest (DBC's gap).
 const LEVEL_TOLERANCE_M: f64 = 0.015;

@@ -58,7 +58,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         return super::bench_frames::run(&args.flume, args.steps_seconds);
     }
     if args.levels {
-        if !(args.until >= 20.0) {
+        if args.until.is_nan() || args.until < 20.0 {
             bail!(
                 "--until: {} s is too short to measure a drift; use at least 20",
                 args.until

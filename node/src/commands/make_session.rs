@@ -20,7 +20,7 @@
 //! from a seeded generator (SplitMix64 with Box-Muller), so a seed makes the same file.
 //!
 //! A check against the experiment: the paper's front took 8 s to reach the end of the flume
-//! at 2 m3/h; this model's front takes about 10 s to reach the weir of `ulbra_flume.yaml`.
+//! at 2 m3/h; this model fills the bed and the pit of `ulbra_flume.yaml` in 12 s.
 
 use crate::adapters::bag::BagWriter;
 use crate::adapters::topics;
