@@ -347,7 +347,10 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
             .iter()
             .any(|p| p.name == phase && p.sediment.is_some())
     };
-    let block = |min: &[f64], max: &[f64]| format!("{{min_m: {min:?}, max_m: {max:?}}}");
+    let bounds = |min: &[f64], max: &[f64]| format!("min_m: {min:?}, max_m: {max:?}");
+    let block = |min: &[f64], max: &[f64]| format!("{{{}}}", bounds(min, max));
+    let fluid =
+        |phase: &str, min: &[f64], max: &[f64]| format!("{{phase: {phase}, {}}}", bounds(min, max));
     let walls: Vec<String> = case
         .walls
         .blocks
@@ -366,12 +369,8 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
         .fluid_blocks
         .iter()
         .filter(|b| !is_bed(&b.phase))
-        .map(|b| format!("{{phase: {}, {}", b.phase, &block(&b.min_m, &b.max_m)[1..]))
-        .chain([format!(
-            "{{phase: {}, {}",
-            water.name,
-            &block(&pit, &crest)[1..]
-        )])
+        .map(|b| fluid(&b.phase, &b.min_m, &b.max_m))
+        .chain([fluid(&water.name, &pit, &crest)])
         .collect();
     Ok(vec![
         format!("walls.blocks=[{}]", walls.join(", ")),

@@ -7,6 +7,7 @@
 
 use super::grid::{Grid, Group};
 use super::simd;
+use crate::physics::boundary::WallSums;
 use crate::physics::interaction::{PairModel, PairSum, Side};
 use crate::physics::lanes::{Lanes, Real};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
@@ -123,7 +124,17 @@ impl Pass<'_> {
     fn finish(&self, i: usize, sum: &PairSum) -> ([f32; 4], f32) {
         let side = &self.sides[i];
         let imposed = self.extra.imposed.get(i).copied().unwrap_or(false);
-        let (f, mut dt) = self.model.finish(side, sum, !imposed);
+        let (mut f, mut dt) = self.model.finish(side, sum, !imposed);
+        if !side.mobile && self.model.params().generalised_walls {
+            // A wall's fourth entry is then its density, not a rate (`physics::boundary`).
+            let mut wall = WallSums::default();
+            self.grid.rows(self.grid.coords(&side.x), |range| {
+                for j in range {
+                    self.model.add_wall_pair(side, &self.sides[j], &mut wall);
+                }
+            });
+            f[3] = self.model.wall_density(side, &wall);
+        }
         if let Some((_, _, mu)) = self.extra.stress
             && dt.is_finite()
         {
