@@ -338,7 +338,8 @@ pub struct BenchArgs {
         value_name = "DP1,DP2,...",
         value_delimiter = ',',
         default_value = "0.01,0.007,0.005",
-        requires = "levels"
+        requires = "levels",
+        allow_negative_numbers = true
     )]
     pub dp: Vec<f64>,
     /// With --levels: the constant discharge, m3/h.

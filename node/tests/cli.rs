@@ -82,6 +82,39 @@ fn negative_dp_is_refused_by_name() {
     );
 }
 
+/// `bench --levels` refuses what it cannot run before any run starts, saying which flag: a
+/// resolution that is no length, a run too short for a drift, a value the case refuses.
+#[test]
+fn bench_levels_refuses_bad_flags_before_it_runs() {
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["--dp", "0.01,-0.007"],
+            "--dp: -0.007 is not a positive length",
+        ),
+        (&["--until", "5"], "--until: 5 s is too short"),
+        (
+            &["--dp", "0.01", "--set", "numerics.cfl=-1"],
+            "numerics.cfl",
+        ),
+    ];
+    for (args, want) in cases {
+        let flume = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../launch_configs/ulbra_flume.yaml"
+        );
+        let mut all = vec!["bench", "--levels", "--flume", flume];
+        all.extend(args);
+        let out = flume_twin(&all);
+        let stderr = text(&out.stderr);
+        assert!(!out.status.success(), "{all:?} ran");
+        assert!(stderr.contains(want), "{all:?}: {stderr}");
+        assert!(
+            !text(&out.stdout).contains("backend:"),
+            "{all:?} started a run"
+        );
+    }
+}
+
 #[test]
 fn missing_case_file_is_reported() {
     let dir = scratch("missing_case");
