@@ -167,6 +167,15 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         ..channel.clone()
     }
     .steady(q, width);
+    // The reference's sensitivity to its one friction parameter, which the issue asks for.
+    let with_n = |factor: f64| {
+        Channel {
+            manning_n: factor * channel.manning_n,
+            ..channel.clone()
+        }
+        .steady(q, width)
+    };
+    let (n_low, n_high) = (with_n(0.8), with_n(1.2));
     let q_unit = q / width;
     let head = channel.weir.head_m(q_unit);
     println!(
@@ -189,6 +198,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         "model - ref (mm)",
         "drift (mm/10 s)",
         "glass walls (mm)",
+        "n -/+20 % (mm)",
     ]);
     for (g, gauge) in case.observations.gauges.iter().enumerate() {
         let x = gauge.position_m[0];
@@ -207,6 +217,11 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
                     .map(|(a, b)| format!("{:+.1}", 1e3 * (a - b))),
             ),
             format!("{:+.1}", 1e3 * (glass.level_m(x) - want)),
+            format!(
+                "{:+.1} / {:+.1}",
+                1e3 * (n_low.level_m(x) - want),
+                1e3 * (n_high.level_m(x) - want)
+            ),
         ]);
     }
     print!("{table}");
