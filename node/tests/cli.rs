@@ -513,3 +513,38 @@ fn a_normal_start_prints_nothing_alarming() {
         assert!(!alarming, "{line:?} at start:\n{said}");
     }
 }
+
+/// A flume whose bed is a wall block (the clear-water flume of `bench --levels --fixed-bed`)
+/// has a profile but no sediment in it: the run ends normally and says there is no bed plot
+/// (it used to end with an error after the whole run).
+#[test]
+fn a_clear_water_flume_run_ends_without_a_bed_plot() {
+    let dir = scratch("clear_water_run");
+    let path = repo_file("launch_configs/ulbra_flume.yaml");
+    let sand = flume_solver::Case::from_path_with(&path, &["numerics.dp_m=0.01".to_string()])
+        .expect("the flume case");
+    let overrides = flume_solver::hydraulics::fixed_bed_overrides(&sand).expect("a bed");
+    let mut args = vec![
+        "simulate".to_string(),
+        path.to_str().unwrap().to_string(),
+        "--set".into(),
+        "numerics.dp_m=0.01".into(),
+        "--until".into(),
+        "0.05".into(),
+        "--no-snapshots".into(),
+        "--out".into(),
+        dir.join("out").to_str().unwrap().to_string(),
+    ];
+    for o in overrides {
+        args.extend(["--set".to_string(), o]);
+    }
+    let out = flume_twin(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let stdout = text(&out.stdout);
+    assert!(
+        out.status.success(),
+        "simulate failed: {}\n{stdout}",
+        text(&out.stderr)
+    );
+    assert!(stdout.contains("bed plot: none"), "{stdout}");
+    assert!(!dir.join("out/bed.png").exists());
+}

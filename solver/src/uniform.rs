@@ -6,6 +6,7 @@ use crate::config::{
     BoundaryMethod, Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion,
 };
 use crate::derived::{self, Derived};
+use crate::flume::inlet_velocity;
 use crate::gpu::params::*;
 use crate::health::{RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
 use crate::particles::{Parking, parked_phase};
@@ -129,7 +130,7 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
         // opening, and a row must not drop out of the zone by rounding.
         inlet_y_min: f.inlet.y_min_m as f32,
         inlet_y_max: (f.inlet.y_min_m + f.inlet.height_m + 0.5 * dp) as f32,
-        inlet_u: inlet_velocity(f, f.inflow_m3_per_s) as f32,
+        inlet_u: inlet_velocity(f, f.inflow_m3_per_s, dp) as f32,
         outlet_x: (hi[0] + f64::from(case.walls.layers) * dp) as f32,
         collector_x_min: f.collector.x_min_m as f32,
         collector_x_max: f.collector.x_max_m as f32,
@@ -143,11 +144,6 @@ fn flume_params(case: &Case, derived: &Derived) -> FlumeGpu {
         duct_u: duct[3] as f32,
         pad: 0.0,
     }
-}
-
-/// Inlet velocity of discharge `q` (m3/s) through the opening: Q / (height x width), m/s.
-pub fn inlet_velocity(f: &crate::config::OpenFlume, q: f64) -> f64 {
-    q / (f.inlet.height_m * f.width_m)
 }
 
 /// The sediment block of the uniform; all zero (phase 0, the walls) when the case has none.

@@ -110,7 +110,9 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     bar.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
-    if recorder.has_bed_profile() {
+    if recorder.has_bed_profile() && !bed_plot::holds_sediment(&bed_profiles) {
+        println!("bed plot: none, no profile column held sediment");
+    } else if recorder.has_bed_profile() {
         let path = out_dir.join("bed.png");
         bed_plot::draw(&path, &case.name, &initial_profile, &bed_profiles)?;
         println!("bed plot: {}", path.display());

@@ -5,7 +5,7 @@ use super::Simulation;
 use crate::derived::{MAX_INLET_MACH, max_inflow_m3_per_s};
 use crate::error::SolverError;
 use crate::flume::BoundaryConditions;
-use crate::uniform::inlet_velocity;
+use crate::flume::inlet_velocity;
 
 /// Discharges to apply on the way to a time: `(time s, discharge m3/s)` in time order, each
 /// in force from its own time on (one stamped before the simulation's time applies at once).
@@ -52,7 +52,7 @@ impl Simulation {
             .iter()
             .flat_map(|&x| heights.iter().map(move |&y| [x as f32, y as f32]))
             .collect();
-        let u = f.inlet_velocity() as f32;
+        let u = f.inlet_velocity(dp) as f32;
         let fl = self.params.flume;
         // The buffer keeps the density its particles enter with (store_state.wgsl): rest.
         let rho = self.params.phases[fl.water_phase as usize].rho0;
@@ -105,7 +105,7 @@ impl Simulation {
                 reason: format!("must be a finite discharge >= 0 m3/s, got {q}"),
             });
         }
-        let u = inlet_velocity(&f.config, q);
+        let u = inlet_velocity(&f.config, q, self.case.numerics.dp_m);
         if q > max_inflow_m3_per_s(&f.config, c0) {
             return Err(SolverError::InvalidParameter {
                 name: "inflow",

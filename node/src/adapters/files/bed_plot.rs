@@ -85,6 +85,14 @@ fn panel_lines(initial: &[ProfileColumn], now: &[ProfileColumn]) -> Vec<Line> {
     ]
 }
 
+/// Whether some column of `profiles` holds sediment: a flume whose bed is a wall block (clear
+/// water) has a profile but no bed to plot.
+pub fn holds_sediment(profiles: &[(f64, Vec<ProfileColumn>)]) -> bool {
+    profiles
+        .iter()
+        .any(|(_, p)| p.iter().any(|c| zs(c).is_some()))
+}
+
 /// Draws `path` (PNG, 1200 wide, one panel of `PANEL_HEIGHT` per profile): for each
 /// `(t, profile)` of `profiles` Zw, Zs and Zb at t against the initial bed surface, all panels
 /// on the same axes.
@@ -97,10 +105,7 @@ pub fn draw(
     if profiles.is_empty() {
         return Err(anyhow!("a bed plot needs at least one profile"));
     }
-    if !profiles
-        .iter()
-        .any(|(_, p)| p.iter().any(|c| zs(c).is_some()))
-    {
+    if !holds_sediment(profiles) {
         return Err(anyhow!("no column holds sediment: nothing to plot"));
     }
     let panels: Vec<(f64, Vec<Line>)> = profiles
