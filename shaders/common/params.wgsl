@@ -79,7 +79,7 @@ struct SimParams {
     euler_every: u32,        // Verlet: an Euler step every this many steps
     clamp_pressure: u32,     // 1: no tension: fluid density floored at rest, pressure >= 0
     boundary_mode: u32,      // 0: dynamic boundary particles, 1: generalised walls (Adami 2012)
-    pad2: u32,
+    sps_length2: f32,        // (C_s dp)^2 of water's sub-particle-scale viscosity, m2 (0: none)
     phases: array<Phase, 4>,
     tait_b: vec4<f32>,       // c0^2 rho0 / 7 per phase
     sediment: Sediment,

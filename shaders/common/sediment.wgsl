@@ -206,6 +206,12 @@ fn drucker_prager_yield(rho: f32) -> f32 {
     return sd.dp_alpha * max(p_skel, 0.0) + sd.dp_kappa;
 }
 
+// The Smagorinsky sub-particle-scale viscosity rho (C_s dp)^2 2 sqrt(II_D), Pa s
+// (`sps_viscosity` in rheology.rs).
+fn sps_viscosity(rho: f32, ii_d: f32) -> f32 {
+    return rho * params.sps_length2 * 2.0 * sqrt(max(ii_d, 0.0));
+}
+
 // Eq. 33, Vand's suspension viscosity, Pa s.
 fn vand_viscosity(c_v: f32) -> f32 {
     return params.sediment.mu_w * exp(2.5 * c_v / (1.0 - 39.0 / 64.0 * c_v));

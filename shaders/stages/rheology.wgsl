@@ -109,7 +109,8 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let ii_d = 0.5 * (dot(eps[0], eps[0]) + dot(eps[1], eps[1]) + dot(eps[2], eps[2]));
 
-    var mu = ph_i.mu;
+    // Water's own viscosity and its eddy viscosity; sediment takes its region's below.
+    var mu = ph_i.mu + sps_viscosity(rho_i, ii_d);
     var region = REGION_WATER;
     if (is_sediment) {
         let tau_y = drucker_prager_yield(rho_i);

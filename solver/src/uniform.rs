@@ -55,7 +55,13 @@ pub fn sim_params(
     let (viscosity_mode, alpha) = match case.numerics.viscosity {
         Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha),
         Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0),
-        Viscosity::Multiphase { alpha } => (VISCOSITY_MULTIPHASE, alpha),
+        Viscosity::Multiphase { alpha, .. } => (VISCOSITY_MULTIPHASE, alpha),
+    };
+    let sps_length2 = match case.numerics.viscosity {
+        Viscosity::Multiphase { smagorinsky_cs, .. } => {
+            (smagorinsky_cs * case.numerics.dp_m).powi(2) as f32
+        }
+        _ => 0.0,
     };
     let (diffusion_mode, delta) = match case.numerics.density_diffusion {
         DensityDiffusion::None => (DIFFUSION_NONE, 0.0),
@@ -99,7 +105,7 @@ pub fn sim_params(
             BoundaryMethod::Dynamic => BOUNDARY_DYNAMIC,
             BoundaryMethod::Generalised => BOUNDARY_GENERALISED,
         },
-        pad: 0,
+        sps_length2,
         phases,
         tait_b,
         sediment: sediment_params(case, derived),

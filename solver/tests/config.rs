@@ -203,6 +203,12 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
             "multiphase",
         ),
         (
+            "viscosity: { method: multiphase, alpha: 0.02 }",
+            "viscosity: { method: multiphase, alpha: 0.02, smagorinsky_cs: -0.12 }",
+            "numerics.viscosity.smagorinsky_cs",
+            "0..=1",
+        ),
+        (
             "rho0_kg_per_m3: 2710.0",
             "rho0_kg_per_m3: 900.0",
             "phases[1].rho0_kg_per_m3",

@@ -81,6 +81,11 @@ fn rheology_matches_the_oracle_shields_only() {
 }
 
 #[test]
+fn rheology_matches_the_oracle_with_the_waters_eddy_viscosity() {
+    stages::check_rheology(&CPU, stages::eddy_viscosity_case(), 24);
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     parked::check_parked_take_no_part(&CPU);
 }

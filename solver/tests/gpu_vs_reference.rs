@@ -87,6 +87,11 @@ fn rheology_matches_the_cpu_shields_only() {
 }
 
 #[test]
+fn rheology_matches_the_cpu_with_the_waters_eddy_viscosity() {
+    on_gpu(|b| stages::check_rheology(b, stages::eddy_viscosity_case(), 24));
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     on_gpu(parked::check_parked_take_no_part);
 }

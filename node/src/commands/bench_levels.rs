@@ -6,7 +6,8 @@
 //!
 //! Per run it prints:
 //! - each gauge's mean level over the last 10 s against the reference, and its drift (the last
-//!   10 s' mean less the 10 s' before);
+//!   10 s' mean less the 10 s' before), and the same for a gauge added in the pool before the
+//!   weir, whose level is the weir's head alone;
 //! - the discharge over the weir and the one the inlet placed, over the last 10 s, against the
 //!   discharge asked (particles parked at the outlet, dp^2 each per metre of width);
 //! - at the end, in 10 cm columns from x = 0.3 to 2.1 m: the 5th percentile of the water
@@ -18,6 +19,7 @@
 
 use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
+use flume_solver::config::GaugeConfig;
 use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, SideWalls, fixed_bed_overrides};
 use flume_solver::{Backend, Case, Observations, ParticleRegion, Simulation};
 use std::path::Path;
@@ -85,12 +87,22 @@ fn level_case(flume: &Path, set: &[String], r: &LevelRun) -> Result<(Case, Chann
         .with_context(|| format!("the flume at dp = {} m was refused", r.dp_m))?;
     let channel = Channel::as_generated(&sand).map_err(anyhow::Error::msg)?;
     if !r.fixed_bed {
-        return Ok((sand, channel));
+        return Ok((with_pool_gauge(sand, &channel), channel));
     }
     overrides.extend(fixed_bed_overrides(&sand).map_err(anyhow::Error::msg)?);
     let fixed = Case::from_path_with(flume, &overrides)
         .with_context(|| format!("the fixed-bed flume at dp = {} m was refused", r.dp_m))?;
-    Ok((fixed, channel))
+    Ok((with_pool_gauge(fixed, &channel), channel))
+}
+
+/// The case with one more gauge, "pool", halfway between the bed's end and the weir: the
+/// weir's own head, apart from the friction over the bed that the gauges upstream add to it.
+fn with_pool_gauge(mut case: Case, channel: &Channel) -> Case {
+    case.observations.gauges.push(GaugeConfig {
+        name: "pool".into(),
+        position_m: vec![0.5 * (channel.x_bed_end_m + channel.weir.x_m)],
+    });
+    case
 }
 
 fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> Result<()> {

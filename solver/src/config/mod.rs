@@ -336,6 +336,12 @@ pub enum Viscosity {
     Multiphase {
         #[serde(default)]
         alpha: f64,
+        /// The Smagorinsky constant C_s of the sub-particle-scale eddy viscosity that water adds
+        /// to its own (Dalrymple & Rogers 2006, as DualSPHysics' laminar + SPS): mu_t =
+        /// rho (C_s dp)^2 |S|, |S| = sqrt(2 S:S). 0 (the default) for none; DualSPHysics
+        /// uses 0.12.
+        #[serde(default)]
+        smagorinsky_cs: f64,
     },
 }
 

@@ -200,7 +200,15 @@ impl Case {
             }
             _ => {}
         }
-        if let Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } = n.viscosity
+        if let Viscosity::Multiphase { smagorinsky_cs, .. } = n.viscosity
+            && !(smagorinsky_cs.is_finite() && (0.0..=1.0).contains(&smagorinsky_cs))
+        {
+            return err(
+                "numerics.viscosity.smagorinsky_cs",
+                format!("must be in 0..=1, got {smagorinsky_cs}"),
+            );
+        }
+        if let Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha, .. } = n.viscosity
             && !(alpha.is_finite() && (0.0..=10.0).contains(&alpha))
         {
             return err(

@@ -206,7 +206,13 @@ mod tests {
             .num_threads(2)
             .build()
             .expect("a pool of two threads");
-        for viscosity in [Viscosity::Multiphase { alpha: 0.05 }, Viscosity::Laminar] {
+        for viscosity in [
+            Viscosity::Multiphase {
+                alpha: 0.05,
+                sps_length2: 0.0,
+            },
+            Viscosity::Laminar,
+        ] {
             let fx = fixture(viscosity);
             let model = PairModel::new(&fx.params);
             let sides: Vec<Side> = (0..fx.pos.len())

@@ -157,7 +157,10 @@ mod tests {
 
     #[test]
     fn each_lane_gets_the_rheology_of_its_particle_alone() {
-        let fx = fixture(Viscosity::Multiphase { alpha: 0.05 });
+        let fx = fixture(Viscosity::Multiphase {
+            alpha: 0.05,
+            sps_length2: 0.0,
+        });
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .build()

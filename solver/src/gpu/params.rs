@@ -92,7 +92,8 @@ pub struct SimParams {
     pub euler_every: u32,
     pub clamp_pressure: u32,
     pub boundary_mode: u32,
-    pub pad: u32,
+    /// `(C_s dp)^2` of the multiphase model's sub-particle-scale viscosity, m2 (0: none).
+    pub sps_length2: f32,
     pub phases: [PhaseParams; MAX_PHASES],
     pub tait_b: [f32; 4],
     pub sediment: SedimentGpu,
@@ -238,7 +239,10 @@ impl SimParams {
             viscosity: match self.viscosity_mode {
                 VISCOSITY_ARTIFICIAL => Viscosity::Artificial { alpha: self.alpha },
                 VISCOSITY_LAMINAR => Viscosity::Laminar,
-                _ => Viscosity::Multiphase { alpha: self.alpha },
+                _ => Viscosity::Multiphase {
+                    alpha: self.alpha,
+                    sps_length2: self.sps_length2,
+                },
             },
             cfl: self.cfl,
             phases: self.phases[..n_phases.min(MAX_PHASES)]

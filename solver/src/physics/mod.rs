@@ -48,8 +48,9 @@ pub enum Viscosity {
     Laminar,
     /// Viscous stress from each particle's strain rate (Eqs. 10-15), added as the stress
     /// divergence of [`sediment::pass`]; here only Monaghan's artificial viscosity with
-    /// coefficient `alpha` (0 for none).
-    Multiphase { alpha: f32 },
+    /// coefficient `alpha` (0 for none). Water's viscosity there gains the sub-particle-scale
+    /// eddy viscosity `rho sps_length2 |S|`, `sps_length2 = (C_s dp)^2` in m2 (0 for none).
+    Multiphase { alpha: f32, sps_length2: f32 },
 }
 
 /// Numerical parameters of one run.

@@ -89,8 +89,12 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
                 alpha: alpha as f32,
             },
             CaseViscosity::Laminar => Viscosity::Laminar,
-            CaseViscosity::Multiphase { alpha } => Viscosity::Multiphase {
+            CaseViscosity::Multiphase {
+                alpha,
+                smagorinsky_cs,
+            } => Viscosity::Multiphase {
                 alpha: alpha as f32,
+                sps_length2: (smagorinsky_cs * case.numerics.dp_m).powi(2) as f32,
             },
         },
         cfl: case.numerics.cfl as f32,

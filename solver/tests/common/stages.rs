@@ -603,6 +603,17 @@ pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
     }
 }
 
+/// [`shields_only_case`] with the water's sub-particle-scale eddy viscosity (C_s = 0.12), which
+/// outweighs its own viscosity forty-fold in the perturbed flow.
+pub fn eddy_viscosity_case() -> Case {
+    let mut c = shields_only_case();
+    c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {
+        alpha: 0.05,
+        smagorinsky_cs: 0.12,
+    };
+    c
+}
+
 /// The sediment bed in the Shields-only mode, with artificial viscosity on top of the stress
 /// and without tension, as the flume case runs (the perturbed densities, 1 % either side of
 /// rest, give negative pressures).
@@ -613,7 +624,10 @@ pub fn shields_only_case() -> Case {
         s.hbp_m_s = 0.0;
         s.hbp_n = 1.0;
     }
-    c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase { alpha: 0.05 };
+    c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {
+        alpha: 0.05,
+        smagorinsky_cs: 0.0,
+    };
     c.numerics.clamp_negative_pressure = true;
     c
 }

@@ -284,7 +284,7 @@ impl<'a> PairModel<'a> {
         let mu_ij = s(params.h) * vdotr / (r2 + s(self.eta2));
         sum.visc_max = L::select(near, sum.visc_max.max(mu_ij.abs()), sum.visc_max);
         match params.viscosity {
-            Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha } => {
+            Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha, .. } => {
                 // Only approaching pairs are damped.
                 let pi_ij = s(-alpha * params.c0) * mu_ij / (s(0.5) * (i.rho + rho_j));
                 coef = L::select(vdotr.lt(s(0.0)), coef - m_j * pi_ij, coef);

@@ -14,7 +14,7 @@
 
 use super::SedimentParams;
 use super::drucker_prager::{alpha, kappa_c, yield_stress};
-use super::rheology::{Tensor3, hbp_viscosity, second_invariant, strain_rate};
+use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
     bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity, k_beta,
     k_gamma, sloped_critical_stress,
@@ -22,11 +22,11 @@ use super::shields::{
 use super::suspension::{
     Region, SUSPENSION_CONCENTRATION, apparent_viscosity, classify, volume_fraction,
 };
-use crate::physics::Params;
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::phase_index;
 use crate::physics::kernel::Wendland;
 use crate::physics::lanes::{Lanes, Mask, Real, pack};
+use crate::physics::{Params, Viscosity};
 
 /// The sediment model of one run.
 #[derive(Clone, Debug, PartialEq)]
@@ -236,6 +236,8 @@ pub struct Rheology<'a> {
     reference_mass: f32,
     /// Tait's stiffness of the sediment.
     b_sed: f32,
+    /// `(C_s dp)^2` of water's eddy viscosity, m2 (0: none).
+    sps_length2: f32,
 }
 
 impl<'a> Rheology<'a> {
@@ -252,6 +254,10 @@ impl<'a> Rheology<'a> {
             kappa_dp: kappa_c(mat.phi_rad, mat.cohesion_pa),
             reference_mass: mat.surface_mass_fraction * sed.mass,
             b_sed: tait_b(params.c0, sed.rho0),
+            sps_length2: match params.viscosity {
+                Viscosity::Multiphase { sps_length2, .. } => sps_length2,
+                _ => 0.0,
+            },
             params,
             model,
         }
@@ -378,7 +384,8 @@ impl<'a> Rheology<'a> {
         let (region, mu, held) = if self.is_sediment(x_i) {
             self.classify(v_i[3], s, ii_d, held_before)
         } else {
-            (Region::Water as u32, phase_i.mu, false)
+            let eddy = sps_viscosity(v_i[3], self.sps_length2, ii_d);
+            (Region::Water as u32, phase_i.mu + eddy, false)
         };
         let mut stress = [[0.0_f32; 3]; 3];
         // Shields-only holds carry no stress, as that mode always had; Drucker-Prager holds
