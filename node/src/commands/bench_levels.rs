@@ -13,7 +13,9 @@
 //! - at the end, in 10 cm columns from x = 0.3 to 2.1 m: the 5th percentile of the water
 //!   particles' heights above the column's top held sand particle (or the fixed bed's top wall
 //!   particle), in dp (the cushion under the flow), and that sand particle's Tait pressure
-//!   over the weight of the water above it.
+//!   over the weight of the water above it; the median of it, and of the pressure the water
+//!   feels from it (`p rho_w / rho_s`: Eq. 10 weighs a neighbour's pressure by its volume over
+//!   its density).
 //!
 //! Nothing is asserted: the figures are for the log and the issue's goals.
 
@@ -376,9 +378,15 @@ fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
         } else {
             let mut r = ratios.clone();
             r.sort_by(f64::total_cmp);
+            // The momentum equation weighs a neighbour's pressure by m_j / rho_j^2 = V_j /
+            // rho_j: water feels sand of Tait pressure p as water of p rho_w / rho_s. At equal
+            // compression sand's Tait pressure is rho_s / rho_w times water's.
+            let felt = rho_w / derived.phases[sand as usize].rho0;
             format!(
-                "; the top sand's pressure over the water's weight: median {:.2} (goal 0.75-1.25)",
-                r[r.len() / 2]
+                "; the top sand's Tait pressure over the water's weight: median {:.2}, as the \
+                 water feels it (x rho_w / rho_s) {:.2} (goal 0.75-1.25)",
+                r[r.len() / 2],
+                r[r.len() / 2] * felt
             )
         }
     );
