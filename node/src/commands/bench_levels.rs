@@ -21,9 +21,10 @@
 
 use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
+use flume_solver::bed_contact::bed_contact;
 use flume_solver::config::GaugeConfig;
 use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, SideWalls, fixed_bed_overrides};
-use flume_solver::{Backend, Case, Observations, ParticleRegion, Simulation};
+use flume_solver::{Backend, Case, Observations, Simulation};
 use std::path::Path;
 use std::time::Instant;
 
@@ -282,33 +283,15 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
     );
 }
 
-/// The cushion under the flow and the held bed's push, column by column, at the run's end.
+/// The cushion under the flow and the held bed's push, column by column, at the run's end
+/// (`flume_solver::bed_contact`).
 fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
     let particles = sim.read_particles()?;
     // Particles come in id order, as the region words do.
     let regions = sim.regions()?;
-    let held = |i: usize| {
-        regions
-            .get(i)
-            .is_some_and(|&w| ParticleRegion::from_word(w).held)
-    };
-    let dp = case.numerics.dp_m;
-    let derived = sim.derived();
-    let Some((sediment, water)) = case.sediment_phases() else {
+    let Some(contact) = bed_contact(case, sim.derived(), &particles, &regions) else {
         return Ok(());
     };
-    let (sand, water) = (sediment as u32 + 1, water as u32 + 1);
-    let sand_there = (0..particles.len()).any(|i| particles.phase(i) == sand);
-    // The bed is the held sand, or the wall block that stands in for it.
-    let in_bed = |i: usize| {
-        if sand_there {
-            particles.phase(i) == sand && held(i)
-        } else {
-            particles.phase(i) == 0
-        }
-    };
-    let rho_w = derived.phases[water as usize].rho0;
-    let g = case.gravity_magnitude();
     let mut table = Table::new([
         "x (m)",
         "bed top (m)",
@@ -316,79 +299,44 @@ fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
         "surface (m)",
         "bed p / water weight",
     ]);
-    let (mut gaps, mut ratios) = (Vec::new(), Vec::new());
-    for k in 0..18 {
-        let (x0, x1) = (0.3 + 0.1 * k as f64, 0.4 + 0.1 * k as f64);
-        let inside = |i: usize| {
-            let x = f64::from(particles.positions[i][0]);
-            x >= x0 && x < x1
+    for c in &contact.columns {
+        let (gap, surface, ratio) = match &c.wet {
+            None => ("dry".to_string(), "-".to_string(), None),
+            Some(w) => (
+                format!("{:.2}", w.gap_dp),
+                format!("{:.4}", w.surface_m),
+                w.tait_over_load,
+            ),
         };
-        let y = |i: usize| f64::from(particles.positions[i][1]);
-        let top = (0..particles.len())
-            .filter(|&i| inside(i) && in_bed(i) && y(i) < 0.15)
-            .max_by(|&a, &b| y(a).total_cmp(&y(b)));
-        let mut heights: Vec<f64> = (0..particles.len())
-            .filter(|&i| inside(i) && particles.phase(i) == water)
-            .map(y)
-            .collect();
-        let Some(top) = top else { continue };
-        if heights.is_empty() {
-            table.row([
-                format!("{x0:.1}"),
-                format!("{:.4}", y(top)),
-                "dry".into(),
-                "-".into(),
-                "-".into(),
-            ]);
-            continue;
-        }
-        heights.sort_by(f64::total_cmp);
-        let p5 = heights[(heights.len() as f64 * 0.05) as usize];
-        let surface = heights[heights.len() - 1] + 0.5 * dp;
-        let gap = (p5 - y(top)) / dp;
-        gaps.push(gap);
-        let ratio = sand_there.then(|| {
-            let rho0 = derived.phases[sand as usize].rho0;
-            let b = derived.c0 * derived.c0 * rho0 / 7.0;
-            let rho = f64::from(particles.vel_rho[top][3]);
-            let p = b * ((rho / rho0).powi(7) - 1.0);
-            p / (rho_w * g * (surface - y(top)))
-        });
-        ratios.extend(ratio);
         table.row([
-            format!("{x0:.1}"),
-            format!("{:.4}", y(top)),
-            format!("{gap:.2}"),
-            format!("{surface:.4}"),
+            format!("{:.1}", c.x_min_m),
+            format!("{:.4}", c.bed_top_m),
+            gap,
+            surface,
             ratio.map_or("-".to_string(), |r| format!("{r:.2}")),
         ]);
     }
     print!("{table}");
-    let worst = gaps.iter().copied().fold(f64::NAN, f64::max);
     // Water can leave only over the weir: any below the floor went through a wall.
+    let dp = case.numerics.dp_m;
     let floor = case.domain.min_m[1] - f64::from(case.walls.layers) * dp;
+    let water = case.sediment_phases().map_or(1, |(_, w)| w as u32 + 1);
     let lost = (0..particles.len())
         .filter(|&i| particles.phase(i) == water && f64::from(particles.positions[i][1]) < floor)
         .count();
     println!("water particles below the floor's outer layer (through a wall): {lost}");
+    let push = match (contact.median_tait_over_load(), contact.felt_over_load()) {
+        (Some(tait), Some(felt)) => format!(
+            "; the top sand's Tait pressure over the water's weight: median {tait:.2}, as the \
+             water feels it (x rho_w / rho_s) {felt:.2} (goal 0.75-1.25)"
+        ),
+        _ => String::new(),
+    };
     println!(
-        "water over the bed: largest 5th-percentile gap {worst:.2} dp (the goal: at most 1.2 dp){}",
-        if ratios.is_empty() {
-            String::new()
-        } else {
-            let mut r = ratios.clone();
-            r.sort_by(f64::total_cmp);
-            // The momentum equation weighs a neighbour's pressure by m_j / rho_j^2 = V_j /
-            // rho_j: water feels sand of Tait pressure p as water of p rho_w / rho_s. At equal
-            // compression sand's Tait pressure is rho_s / rho_w times water's.
-            let felt = rho_w / derived.phases[sand as usize].rho0;
-            format!(
-                "; the top sand's Tait pressure over the water's weight: median {:.2}, as the \
-                 water feels it (x rho_w / rho_s) {:.2} (goal 0.75-1.25)",
-                r[r.len() / 2],
-                r[r.len() / 2] * felt
-            )
-        }
+        "water over the bed: largest 5th-percentile gap {} dp (the goal: at most 1.2 dp){push}",
+        contact
+            .largest_gap_dp()
+            .map_or("-".to_string(), |g| format!("{g:.2}"))
     );
     Ok(())
 }
