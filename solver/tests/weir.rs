@@ -1,5 +1,8 @@
-//! The ULBRA flume in clear water at CI size (dp = 1 cm, the sand bed made a fixed wall block,
-//! generalised walls), run at a constant 2 and 4 m3/h to a steady state and held against the weir's
+//! The levels at CI size (dp = 1 cm, generalised walls): the ULBRA flume in clear water, its
+//! held sand under the flow, and the gauges over still water.
+//!
+//! The ULBRA flume in clear water (the sand bed made a fixed wall block) is run at a constant
+//! 2 and 4 m3/h to a steady state and held against the weir's
 //! rating: the 1-D reference of `flume_solver::hydraulics` on the geometry as generated, fixed
 //! before this run was compared with it. The flow over the bed is two to three particles deep.
 //!
