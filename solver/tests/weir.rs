@@ -2,9 +2,9 @@
 //! held sand under the flow, and the gauges over still water.
 //!
 //! The ULBRA flume in clear water (the sand bed made a fixed wall block) is run at a constant
-//! 2 and 4 m3/h to a steady state and held against the weir's
-//! rating: the 1-D reference of `flume_solver::hydraulics` on the geometry as generated, fixed
-//! before this run was compared with it. The flow over the bed is two to three particles deep.
+//! 2 and 4 m3/h to a steady state and held against the weir's rating: the 1-D reference of
+//! `flume_solver::hydraulics` on the geometry as generated, fixed before this run was compared
+//! with it. The flow over the bed is two to three particles deep.
 //!
 //! What is checked, over t = 30-40 s (the flume fills in about 15 s):
 //! - the level at P3, 0.5 m before the pit, within 3 mm of the reference: the weir's control
