@@ -17,7 +17,7 @@
 //! ([`BedContact::felt_over_load`]).
 
 use crate::config::Case;
-use crate::derived::Derived;
+use crate::derived::{Derived, tait_b};
 use crate::particles::{ParticleRegion, Particles};
 
 /// The columns' left edges run from here, m.
@@ -114,7 +114,7 @@ pub fn bed_contact(
     let y = |i: usize| f64::from(particles.positions[i][1]);
     let rho_w = derived.phases[water as usize].rho0;
     let rho_s = derived.phases[sand as usize].rho0;
-    let b_s = derived.c0 * derived.c0 * rho_s / 7.0;
+    let b_s = tait_b(derived.c0, rho_s);
     let g = case.gravity_magnitude();
     let columns = (0..COLUMNS)
         .filter_map(|k| {
@@ -149,4 +149,54 @@ pub fn bed_contact(
         columns,
         felt_factor: rho_w / rho_s,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::derived::derive;
+    use crate::physics::sediment::pass::REGION_HELD;
+
+    /// One column by hand, the flume at dp = 1 cm: held sand topped at y = 0.05 m, water from
+    /// 0.06 to 0.08 m (surface 0.085 m) over it, with a free sand particle beside it that must
+    /// not count as the bed. The gap is (0.06 - 0.05) / dp = 1; the load is 1000 x 9.81 x 0.035
+    /// = 343.35 Pa; a sand density whose Tait pressure is 2.71 times that (B_s = 10^2 x 2710 /
+    /// 7 = 38,714 Pa: (1 + 930.5 / 38,714)^(1/7) = 1.003399, 2719.21 kg/m3) is felt as the load.
+    #[test]
+    fn a_column_by_hand() {
+        let case = Case::from_path_with(
+            std::path::Path::new(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../launch_configs/ulbra_flume.yaml"
+            )),
+            &["numerics.dp_m=0.01".to_string()],
+        )
+        .expect("the bundled case");
+        let derived = derive(&case);
+        let (water, sand) = (1u32, 2u32);
+        let mut p = Particles::default();
+        let mut regions = Vec::new();
+        let mut push = |x: f32, y: f32, phase: u32, rho: f32, held: bool| {
+            p.positions.push([x, y, 0.0, f32::from_bits(phase)]);
+            p.vel_rho.push([0.0, 0.0, 0.0, rho]);
+            p.ids.push(p.ids.len() as u32);
+            regions.push(if held { REGION_HELD } else { 0 });
+        };
+        push(0.35, 0.04, sand, 2715.0, true);
+        push(0.35, 0.05, sand, 2719.21, true);
+        push(0.36, 0.07, sand, 2710.0, false);
+        for k in 0..3 {
+            push(0.34, 0.06 + 0.01 * k as f32, water, 1000.0, false);
+        }
+        let contact = bed_contact(&case, &derived, &p, &regions).expect("a sand bed");
+        assert_eq!(contact.columns.len(), 1, "only x = 0.3-0.4 m has a bed");
+        let c = &contact.columns[0];
+        assert!((c.bed_top_m - 0.05).abs() < 1e-6, "{c:?}");
+        let wet = c.wet.as_ref().expect("water over it");
+        assert!((wet.gap_dp - 1.0).abs() < 1e-4, "{wet:?}");
+        assert!((wet.surface_m - 0.085).abs() < 1e-6, "{wet:?}");
+        let felt = contact.felt_over_load().expect("held sand");
+        assert!((felt - 1.0).abs() < 2e-3, "{felt}");
+        assert!((contact.median_tait_over_load().expect("held") - 2.71).abs() < 6e-3);
+    }
 }

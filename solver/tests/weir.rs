@@ -8,7 +8,8 @@
 //!
 //! What is checked, over t = 30-40 s (the flume fills in about 15 s):
 //! - the level at P3, 0.5 m before the pit, within 3 mm of the reference: the weir's control
-//!   (the case file's DBC walls hold it +9.7 mm high: `bench --levels --fixed-bed`);
+//!   (the case file's DBC walls hold it +9.7 mm high at 2 m3/h, +12.3 mm at 4: `bench
+//!   --levels --fixed-bed [--m3-per-h 4]`);
 //! - the discharge over the weir within 2 % of the inflow: the flume has stopped storing;
 //! - no water through a wall (the leak of an inlet buffer counted in the walls' pressure).
 //!

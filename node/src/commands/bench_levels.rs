@@ -243,7 +243,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
 }
 
 fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
-    let (Some((last, _)), Some((first, _))) = (history.last(), at(history, r.until_s - WINDOW_S))
+    let (Some((last, obs)), Some((first, _))) = (history.last(), at(history, r.until_s - WINDOW_S))
     else {
         return;
     };
@@ -270,16 +270,11 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
         r.m3_per_h,
         d(last.excluded, first.excluded)
     );
-    let rho_s = case
-        .phases
-        .iter()
-        .find_map(|p| p.sediment.as_ref().map(|_| p.rho0_kg_per_m3))
-        .unwrap_or(0.0);
     println!(
         "eroded by t = {:.0} s: {} sand particles in the collector, {:.3} kg/m (Eq. 34)",
         last.t,
         last.eroded,
-        last.eroded as f64 * dp * dp * rho_s
+        obs.flume.as_ref().map_or(0.0, |f| f.eroded_kg_per_m)
     );
 }
 

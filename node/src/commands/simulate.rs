@@ -110,12 +110,14 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     bar.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
-    if recorder.has_bed_profile() && !bed_plot::holds_sediment(&bed_profiles) {
-        println!("bed plot: none, no profile column held sediment");
-    } else if recorder.has_bed_profile() {
-        let path = out_dir.join("bed.png");
-        bed_plot::draw(&path, &case.name, &initial_profile, &bed_profiles)?;
-        println!("bed plot: {}", path.display());
+    if recorder.has_bed_profile() {
+        if bed_plot::holds_sediment(&bed_profiles) {
+            let path = out_dir.join("bed.png");
+            bed_plot::draw(&path, &case.name, &initial_profile, &bed_profiles)?;
+            println!("bed plot: {}", path.display());
+        } else {
+            println!("bed plot: none, no profile column held sediment");
+        }
     }
     for path in plots.draw(&out_dir, &case.name)? {
         println!("plot: {}", path.display());
