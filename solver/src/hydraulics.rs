@@ -131,6 +131,22 @@ pub enum SideWalls {
     Glass { width_m: f64, manning_n: f64 },
 }
 
+/// How the flow off the bed's end meets the pool before the weir: the two limits between which
+/// a collector pit's flow lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PitFlow {
+    /// The jet spreads over the pit's whole depth and slows before the weir: the momentum
+    /// balance of an abrupt expansion, with its Borda-Carnot loss (Chow 1959). It needs a pit
+    /// longer than the reattachment length of the flow over its step, 5-8 step heights for a
+    /// turbulent flow (Eaton & Johnston 1981).
+    Expanded,
+    /// The current crosses the pit at the crest's level without losing head: the level over
+    /// the bed's end carries the pool's energy (its level plus the pool's velocity head), and
+    /// no less than critical depth (a free overfall's control) when that energy is below
+    /// the bed's least specific energy, 1.5 h_c.
+    Carried,
+}
+
 /// The flume as the 1-D reference sees it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
@@ -143,6 +159,7 @@ pub struct Channel {
     /// The bed's Manning n, s/m^(1/3).
     pub manning_n: f64,
     pub side_walls: SideWalls,
+    pub pit: PitFlow,
     pub weir: Weir,
 }
 
@@ -261,6 +278,7 @@ impl Channel {
             bed_m: top(bed_nominal),
             manning_n: strickler_n(ks_m),
             side_walls: SideWalls::None,
+            pit: PitFlow::Expanded,
             weir: Weir {
                 x_m: face_in(hi[0], -1.0),
                 crest_m: top(flume.outlet_weir_m),
@@ -273,21 +291,8 @@ impl Channel {
     /// The steady surface for the discharge `q_m3_per_s` through a flume `width_m` wide.
     pub fn steady(&self, q_m3_per_s: f64, width_m: f64) -> Profile {
         let q = q_m3_per_s / width_m;
-        let g = GRAVITY_M_PER_S2;
         let pool = self.weir.crest_m + self.weir.head_m(q);
-        let v2 = q / (pool - self.weir.floor_m);
-        // Over the bed's end: the pool's level less the Borda-Carnot adjustment, solved for the
-        // depth h1 whose velocity V1 = q / h1 enters it (a few fixed-point rounds converge: the
-        // adjustment is a small fraction of the depth).
-        let mut h1 = pool - self.bed_m;
-        for _ in 0..50 {
-            let v1 = q / h1;
-            h1 = pool + v2 * (v2 - v1) / g - self.bed_m;
-        }
-        let hc = critical_depth_m(q);
-        // A pool below critical depth over the bed's end would mean a supercritical reach: the
-        // bed's end is then a control at critical depth.
-        let h_end = h1.max(hc * 1.001);
+        let h_end = self.bed_end_depth_m(q, pool);
         let n = ((self.x_bed_end_m - self.x_inlet_m) / DX_M).ceil() as usize;
         let mut depths = vec![0.0; n + 1];
         depths[n] = h_end;
@@ -308,6 +313,44 @@ impl Channel {
             pool_level_m: pool,
             x_bed_end_m: self.x_bed_end_m,
         }
+    }
+
+    /// The depth over the bed's end under the pool's level `pool` for the unit discharge `q`
+    /// ([`PitFlow`]), m. A pool below critical depth over the bed's end would mean a
+    /// supercritical reach: the bed's end is then a control at critical depth.
+    fn bed_end_depth_m(&self, q: f64, pool: f64) -> f64 {
+        let g = GRAVITY_M_PER_S2;
+        let v2 = q / (pool - self.weir.floor_m);
+        let hc = critical_depth_m(q);
+        let h1 = match self.pit {
+            PitFlow::Expanded => {
+                // The pool's level less the Borda-Carnot adjustment V2 (V2 - V1) / g, solved
+                // for the depth h1 whose V1 = q / h1 enters it (a few fixed-point rounds
+                // converge: the adjustment is a small fraction of the depth).
+                let mut h1 = pool - self.bed_m;
+                for _ in 0..50 {
+                    let v1 = q / h1;
+                    h1 = pool + v2 * (v2 - v1) / g - self.bed_m;
+                }
+                h1
+            }
+            PitFlow::Carried => {
+                // The subcritical depth of specific energy E, by bisection over (h_c, E]:
+                // h + q^2 / 2 g h^2 grows with h there.
+                let energy = pool + v2 * v2 / (2.0 * g) - self.bed_m;
+                let (mut lo, mut hi) = (hc, energy.max(hc));
+                for _ in 0..100 {
+                    let mid = 0.5 * (lo + hi);
+                    if mid + q * q / (2.0 * g * mid * mid) < energy {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                0.5 * (lo + hi)
+            }
+        };
+        h1.max(hc * 1.001)
     }
 
     /// `-dh/dx = Sf / (1 - Fr^2)` at depth `h`: how fast the depth grows upstream.

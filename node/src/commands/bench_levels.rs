@@ -7,9 +7,14 @@
 //! Per run it prints:
 //! - each gauge's mean level over the last 10 s against the reference, and its drift (the last
 //!   10 s' mean less the 10 s' before), and the same for a gauge added in the pool before the
-//!   weir, whose level is the weir's head alone;
+//!   weir, whose level is the weir's head alone; beside the reference, how it moves with the
+//!   glass walls' friction, with the pit's other limit (`PitFlow::Carried`: the current off the
+//!   bed crosses the pit without spreading) and with Strickler's n -/+20 %;
 //! - the discharge over the weir and the one the inlet placed, over the last 10 s, against the
 //!   discharge asked (particles parked at the outlet, dp^2 each per metre of width);
+//! - at the end, the pool gauge's column: what it passes, and the weir's head counted as energy
+//!   against the rating's over an even approach (a current that has not spread down carries
+//!   velocity head where a still pool holds level);
 //! - at the end, in 10 cm columns from x = 0.3 to 2.1 m: the 5th percentile of the water
 //!   particles' heights above the column's top held sand particle (or the fixed bed's top wall
 //!   particle), in dp (the cushion under the flow), and that sand particle's Tait pressure
@@ -23,7 +28,7 @@ use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
 use flume_solver::bed_contact::bed_contact;
 use flume_solver::config::GaugeConfig;
-use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, SideWalls, fixed_bed_overrides};
+use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, PitFlow, SideWalls, fixed_bed_overrides};
 use flume_solver::{Backend, Case, Observations, Simulation};
 use std::path::Path;
 use std::time::Instant;
@@ -152,6 +157,7 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
     print_levels(case, channel, r, &history);
     print_flow(case, r, &history);
     print_bed(&sim, case)?;
+    print_pool(&sim, case, channel, r, &history)?;
     Ok(())
 }
 
@@ -179,6 +185,12 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
             width_m: width,
             manning_n: GLASS_MANNING_N,
         },
+        ..channel.clone()
+    }
+    .steady(q, width);
+    // The other limit of the pit's flow: the current off the bed crosses it without spreading.
+    let carried = Channel {
+        pit: PitFlow::Carried,
         ..channel.clone()
     }
     .steady(q, width);
@@ -213,6 +225,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         "model - ref (mm)",
         "drift (mm/10 s)",
         "glass walls (mm)",
+        "pit carried (mm)",
         "n -/+20 % (mm)",
     ]);
     for (g, gauge) in case.observations.gauges.iter().enumerate() {
@@ -232,6 +245,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
                     .map(|(a, b)| format!("{:+.1}", 1e3 * (a - b))),
             ),
             format!("{:+.1}", 1e3 * (glass.level_m(x) - want)),
+            format!("{:+.1}", 1e3 * (carried.level_m(x) - want)),
             format!(
                 "{:+.1} / {:+.1}",
                 1e3 * (n_low.level_m(x) - want),
@@ -276,6 +290,72 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
         last.eroded,
         obs.flume.as_ref().map_or(0.0, |f| f.eroded_kg_per_m)
     );
+}
+
+/// The flow through the pool gauge's column at the run's end: what it passes, and the weir's
+/// head counted as energy, `level - crest + sum(u^3) / (2 g sum(u))` over the column's water
+/// particles (Chow 1959's energy coefficient times V^2 / 2g), against the rating's head plus
+/// the velocity head of an even approach over the pool's depth. A surface current that
+/// crosses the pit without spreading down carries head a still pool would hold as level.
+fn print_pool(
+    sim: &Simulation,
+    case: &Case,
+    channel: &Channel,
+    r: &LevelRun,
+    history: &[(Books, Observations)],
+) -> Result<()> {
+    let Some(g) = case
+        .observations
+        .gauges
+        .iter()
+        .position(|g| g.name == "pool")
+    else {
+        return Ok(());
+    };
+    let Some(level) = mean_level(history, g, r.until_s - WINDOW_S, r.until_s) else {
+        return Ok(());
+    };
+    let particles = sim.read_particles()?;
+    let water = case.sediment_phases().map_or(1, |(_, w)| w as u32 + 1);
+    let (x, dp) = (
+        case.observations.gauges[g].position_m[0],
+        case.numerics.dp_m,
+    );
+    let u: Vec<f64> = (0..particles.len())
+        .filter(|&i| particles.phase(i) == water)
+        .filter(|&i| (f64::from(particles.positions[i][0]) - x).abs() < dp)
+        .map(|i| f64::from(particles.vel_rho[i][0]))
+        .collect();
+    let (sum_u, sum_u3) = u
+        .iter()
+        .fold((0.0, 0.0), |(a, b), v| (a + v, b + v * v * v));
+    if sum_u <= 0.0 {
+        return Ok(());
+    }
+    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
+    let q = r.m3_per_h / 3600.0 / width;
+    // Each particle carries dp^2 of the section; the column is 2 dp wide.
+    let passed = sum_u * dp / 2.0;
+    let g0 = flume_solver::hydraulics::GRAVITY_M_PER_S2;
+    let velocity_head = sum_u3 / (2.0 * g0 * sum_u);
+    let weir = &channel.weir;
+    let (head, sharp) = (weir.head_m(q), weir.sharp_head_m(q));
+    let approach = |h: f64| {
+        let v = q / (weir.height_m() + h);
+        h + v * v / (2.0 * g0)
+    };
+    println!(
+        "pool at x = {x:.2} m (t = {:.0} s): the column passes {:.2} of q; velocity head {:.1} mm; \
+         the weir's energy head {:.1} mm against the rating's {:.1} mm (Rehbock's {:.1} mm) \
+         over an even approach",
+        r.until_s,
+        passed / q,
+        1e3 * velocity_head,
+        1e3 * (level - weir.crest_m + velocity_head),
+        1e3 * approach(head),
+        1e3 * approach(sharp)
+    );
+    Ok(())
 }
 
 /// The cushion under the flow and the held bed's push, column by column, at the run's end

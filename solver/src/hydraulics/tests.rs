@@ -11,6 +11,7 @@ fn ulbra(n: f64) -> Channel {
         bed_m: 0.055,
         manning_n: n,
         side_walls: SideWalls::None,
+        pit: PitFlow::Expanded,
         weir: Weir {
             x_m: 2.5,
             crest_m: 0.055,
@@ -120,6 +121,45 @@ fn the_drop_into_the_pit_loses_the_borda_carnot_head() {
     // About 1.8 mm below the pool at 2 m3/h (V1 = 0.31 m/s).
     let drop = p.pool_level_m - p.level_m(2.23);
     assert!(drop > 0.0015 && drop < 0.0022, "{drop}");
+}
+
+#[test]
+fn a_current_carried_over_the_pit_keeps_the_pools_energy() {
+    let c = Channel {
+        pit: PitFlow::Carried,
+        ..ulbra(0.0)
+    };
+    let q = Q_2 / WIDTH;
+    let p = c.steady(Q_2, WIDTH);
+    let h1 = p.depths_m[p.depths_m.len() - 1];
+    // By hand: the pool's energy over the bed is 0.02510 + 0.0807^2 / 2g = 25.43 mm, over
+    // 1.5 h_c = 24.30 mm, so the flow stays subcritical: h1 + q^2 / (2 g h1^2) = 25.43 mm at
+    // h1 = 20.24 mm (V1 = 0.319 m/s), 3.1 mm under the expanded pit's 23.3 mm.
+    assert!((h1 - 0.020_24).abs() < 2e-5, "{h1}");
+    let v2 = q / p.pool_level_m;
+    let lhs = c.bed_m + h1 + (q / h1).powi(2) / (2.0 * GRAVITY_M_PER_S2);
+    let rhs = p.pool_level_m + v2 * v2 / (2.0 * GRAVITY_M_PER_S2);
+    assert!((lhs - rhs).abs() < 1e-9, "{lhs} {rhs}");
+    let expanded = ulbra(0.0).steady(Q_2, WIDTH).level_m(2.23);
+    assert!((expanded - p.level_m(2.23) - 0.0031).abs() < 2e-4);
+    // A crest 1 cm under the bed leaves less energy than the bed's least: critical depth there.
+    let low = Channel {
+        weir: Weir {
+            crest_m: 0.045,
+            ..c.weir
+        },
+        ..c
+    };
+    let h_end = low
+        .steady(Q_2, WIDTH)
+        .depths_m
+        .last()
+        .copied()
+        .unwrap_or(0.0);
+    assert!(
+        (h_end / critical_depth_m(q) - 1.001).abs() < 1e-9,
+        "{h_end}"
+    );
 }
 
 #[test]
