@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{csv_rows, gpu, repo_file};
+use common::{csv_rows, repo_file};
 use flume_solver::Case;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -44,7 +44,6 @@ fn text(bytes: &[u8]) -> String {
 /// eroded mass of Eq. 34 (particles times dp^2 rho_s, per metre), the chart, and the table.
 #[test]
 fn a_roughness_ladder_gives_a_row_per_value_in_order() {
-    let Some(_gpu) = gpu() else { return };
     let dir = scratch("ladder");
     let out_dir = dir.join("out");
     let out = sweep(CASE, &format!("{KEY}=7,1"), &out_dir, &["--until", "0.3"]);
@@ -96,9 +95,70 @@ fn a_roughness_ladder_gives_a_row_per_value_in_order() {
     }
 }
 
-/// Each malformed ladder fails with its reason before the GPU is opened or anything is
+/// The first line naming the backend ("adapter: ...") in a command's output.
+fn adapter_line(stdout: &str) -> Option<String> {
+    stdout
+        .lines()
+        .find(|l| l.starts_with("adapter: "))
+        .map(str::to_string)
+}
+
+/// `sweep` runs on the backend `simulate` chooses, on whatever machine this is and with the
+/// backend named (`FLUME_TWIN_ADAPTER=cpu`): a sweep that opened the GPU itself ran on lavapipe,
+/// six times slower than `simulate` on a machine without a hardware GPU.
+#[test]
+fn sweep_runs_on_the_backend_simulate_chooses() {
+    for wanted in [None, Some("cpu")] {
+        let dir = scratch(&format!("backend_{}", wanted.unwrap_or("default")));
+        let with_env = |c: &mut Command| {
+            if let Some(w) = wanted {
+                c.env("FLUME_TWIN_ADAPTER", w);
+            } else {
+                c.env_remove("FLUME_TWIN_ADAPTER");
+            }
+        };
+        let mut simulate = Command::new(BIN);
+        simulate
+            .arg("simulate")
+            .arg(repo_file(CASE))
+            .args(["--until", "0.01", "--no-snapshots", "--out"])
+            .arg(dir.join("simulate"));
+        with_env(&mut simulate);
+        let simulated = simulate.output().unwrap();
+        assert!(simulated.status.success(), "{}", text(&simulated.stderr));
+        let mut sweep = Command::new(BIN);
+        sweep
+            .arg("sweep")
+            .arg(repo_file(CASE))
+            .args([
+                "--set-values",
+                &format!("{KEY}=3"),
+                "--until",
+                "0.01",
+                "--out",
+            ])
+            .arg(dir.join("sweep"));
+        with_env(&mut sweep);
+        let swept = sweep.output().unwrap();
+        assert!(swept.status.success(), "{}", text(&swept.stderr));
+        let (a, b) = (
+            adapter_line(&text(&simulated.stdout)),
+            adapter_line(&text(&swept.stdout)),
+        );
+        assert!(a.is_some(), "simulate named no backend");
+        assert_eq!(a, b, "FLUME_TWIN_ADAPTER={wanted:?}");
+        if wanted == Some("cpu") {
+            assert!(
+                b.is_some_and(|l| l.contains("CPU")),
+                "FLUME_TWIN_ADAPTER=cpu"
+            );
+        }
+    }
+}
+
+/// Each malformed ladder fails with its reason before a backend is opened or anything is
 /// written. In the non-number case the bad value is the second one: a sweep that ran values
-/// as it read them would open the adapter for the first.
+/// as it read them would open a backend for the first.
 #[test]
 fn malformed_ladders_are_refused_before_any_run() {
     let dir = scratch("malformed");
@@ -146,7 +206,7 @@ fn malformed_ladders_are_refused_before_any_run() {
         }
         assert!(
             !text(&out.stdout).contains("adapter:"),
-            "{ladder} {more:?} opened the GPU first"
+            "{ladder} {more:?} opened a backend first"
         );
         assert!(
             !out_dir.exists(),

@@ -8,10 +8,9 @@ use crate::adapters::table::{Table, sig};
 use crate::cli::SweepArgs;
 use anyhow::{Context, Result, bail};
 use flume_solver::FlumeObservation;
-use flume_solver::{Case, GpuContext, Simulation};
+use flume_solver::{Backend, Case, Simulation};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 const USAGE: &str = "expected KEY=V1,V2,..., e.g. phases.1.sediment.ks_over_d50=1,2,3";
@@ -73,8 +72,8 @@ impl Row {
 
 pub fn run(args: &SweepArgs) -> Result<()> {
     let ladder = Ladder::parse(&args.set_values)?;
-    // Every case is checked before the GPU is opened: a bad value fails at once, on any machine,
-    // and not hours into the sweep.
+    // Every case is checked before a backend is opened: a bad value fails at once, on any
+    // machine, and not hours into the sweep.
     let cases = build_cases(args, &ladder)?;
     let ends: Vec<f64> = cases
         .iter()
@@ -86,8 +85,10 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{name}_sweep")));
 
-    let gpu = Arc::new(GpuContext::new().context("cannot open a GPU adapter")?);
-    println!("adapter: {}", gpu.adapter);
+    // The backend `simulate` chooses (`FLUME_TWIN_ADAPTER`, else a hardware GPU, else the CPU),
+    // so a sweep's runs are the runs `simulate` gives, at its speed.
+    let backend = Backend::choose().context("cannot open a backend")?;
+    println!("adapter: {}", backend.describe());
     std::fs::create_dir_all(&out_dir)
         .with_context(|| format!("cannot create {}", out_dir.display()))?;
     println!(
@@ -99,7 +100,7 @@ pub fn run(args: &SweepArgs) -> Result<()> {
         time_label(&ends),
         out_dir.display()
     );
-    let rows = run_ladder(&gpu, &ladder, &cases, &ends, &out_dir)?;
+    let rows = run_ladder(&backend, &ladder, &cases, &ends, &out_dir)?;
     print_table(&ladder.key, &rows);
     let chart = out_dir.join("sweep.png");
     let bars: Vec<(String, Option<f64>)> = rows
@@ -167,7 +168,7 @@ fn build_cases(args: &SweepArgs, ladder: &Ladder) -> Result<Vec<Case>> {
 
 /// Runs every case in turn; a run that fails is a row with its error, and the next one runs.
 fn run_ladder(
-    gpu: &Arc<GpuContext>,
+    backend: &Backend,
     ladder: &Ladder,
     cases: &[Case],
     ends: &[f64],
@@ -177,7 +178,7 @@ fn run_ladder(
     let mut rows = Vec::new();
     for (k, ((value, case), &end_s)) in ladder.values.iter().zip(cases).zip(ends).enumerate() {
         let label = format!("{}={value}", ladder.key);
-        let row = run_one(gpu, case, end_s, value, &label);
+        let row = run_one(backend, case, end_s, value, &label);
         let outcome = match &row.outcome {
             Ok(f) => format!("eroded {} kg/m", sig(f.eroded_kg_per_m)),
             Err(e) => format!("FAILED: {e}"),
@@ -196,7 +197,7 @@ fn run_ladder(
     Ok(rows)
 }
 
-fn run_one(gpu: &Arc<GpuContext>, case: &Case, end_s: f64, value: &str, label: &str) -> Row {
+fn run_one(backend: &Backend, case: &Case, end_s: f64, value: &str, label: &str) -> Row {
     let started = Instant::now();
     let mut row = Row {
         value: value.to_string(),
@@ -206,7 +207,7 @@ fn run_one(gpu: &Arc<GpuContext>, case: &Case, end_s: f64, value: &str, label: &
         recoveries: 0,
         outcome: Err(String::new()),
     };
-    row.outcome = run_case(gpu, case, end_s, label, &mut row).map_err(|e| format!("{e:#}"));
+    row.outcome = run_case(backend, case, end_s, label, &mut row).map_err(|e| format!("{e:#}"));
     row.wall_s = started.elapsed().as_secs_f64();
     row
 }
@@ -214,13 +215,13 @@ fn run_one(gpu: &Arc<GpuContext>, case: &Case, end_s: f64, value: &str, label: &
 /// Runs `case` to `end_s` interval by interval, keeping in `row` how far it got, and reads the
 /// flume's figures at the end.
 fn run_case(
-    gpu: &Arc<GpuContext>,
+    backend: &Backend,
     case: &Case,
     end_s: f64,
     label: &str,
     row: &mut Row,
 ) -> Result<FlumeObservation> {
-    let mut sim = Simulation::new(Arc::clone(gpu), case).context("cannot set up the simulation")?;
+    let mut sim = Simulation::new(backend.clone(), case).context("cannot set up the simulation")?;
     let interval_s = case.time.output_interval_s;
     // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
     let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;
