@@ -30,6 +30,7 @@ pub use simulation::{InflowSchedule, RefusedInflow, Simulation};
 
 /// How an open flume's water sits on its bed: the cushion under the flow, the held bed's push.
 pub mod bed_contact;
+pub mod budget;
 /// The case file's types: `Case` and its sections.
 pub mod config;
 /// The 1-D hydraulic reference for an open flume's steady levels (weir rating, backwater curve).

@@ -1,7 +1,9 @@
 //! `flume-twin simulate`: an offline run of a case, interval by interval.
 
 use crate::adapters::files::inflow::InflowSeries;
-use crate::adapters::files::{bed_plot, outputs::OutputFiles, series_plot::SeriesPlots};
+use crate::adapters::files::{
+    bed_plot, budget_plot, outputs::OutputFiles, series_plot::SeriesPlots,
+};
 use crate::adapters::progress;
 use crate::adapters::table::{Table, sci, sig};
 use crate::cli::SimulateArgs;
@@ -54,7 +56,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         set_inflow(&mut sim, series, 0.0)?;
     }
 
-    let mut recorder = OutputFiles::create(&out_dir, &case, snapshot_every)?;
+    let mut recorder =
+        OutputFiles::create(&out_dir, &case, sim.initial_particles(), snapshot_every)?;
     let interval_s = case.time.output_interval_s;
     // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
     let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;
@@ -120,6 +123,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
     }
     for path in plots.draw(&out_dir, &case.name)? {
+        println!("plot: {}", path.display());
+    }
+    if recorder.budget_rows().len() > 1 {
+        let path = out_dir.join("sediment_budget.png");
+        budget_plot::draw(&path, &case.name, recorder.budget_rows())?;
         println!("plot: {}", path.display());
     }
     print_summary(&sim, &last, wall_s);

@@ -144,7 +144,7 @@ impl Worker {
             let sim =
                 Simulation::new(backend.clone(), &case).context("cannot set up the simulation")?;
             let recorder = out
-                .map(|dir| OutputFiles::create(dir, &case, None))
+                .map(|dir| OutputFiles::create(dir, &case, sim.initial_particles(), None))
                 .transpose()?;
             Ok(Worker {
                 case,

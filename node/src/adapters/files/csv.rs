@@ -4,6 +4,7 @@
 //! interval it completed.
 
 use flume_solver::Observations;
+use flume_solver::budget::{BudgetRow, STRETCHES};
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
@@ -170,6 +171,54 @@ impl<W: Write> ErodedMassCsv<W> {
             f.eroded_kg,
             f.eroded_rate_kg_per_s,
             f.parked_particles
+        )?;
+        self.w.flush()
+    }
+}
+
+/// sediment_budget.csv: where the sand the flow has moved is at each output, in grains
+/// (`flume_solver::budget`), and the grains mobilised from each stretch of the bed, the
+/// stretch named by its bounds along the flume.
+pub struct BudgetCsv<W: Write> {
+    w: W,
+}
+
+impl<W: Write> BudgetCsv<W> {
+    pub fn new(mut w: W, edges_m: &[f64; STRETCHES + 1]) -> io::Result<Self> {
+        let mut header = String::from(
+            "time_s,mobilised,moving,suspended,deposited,past_bed,collected,excluded,\
+             travelled_far,furthest_m",
+        );
+        for k in 0..STRETCHES {
+            // Three decimals tell the stretches of any flume apart (each is at least a dp wide).
+            let _ = write!(
+                header,
+                ",mobilised_from_{:.3}_{:.3}_m",
+                edges_m[k],
+                edges_m[k + 1]
+            );
+        }
+        writeln!(w, "{header}")?;
+        w.flush()?;
+        Ok(BudgetCsv { w })
+    }
+
+    pub fn row(&mut self, r: &BudgetRow) -> io::Result<()> {
+        let stretches: Vec<String> = r.mobilised_by_stretch.iter().map(u64::to_string).collect();
+        writeln!(
+            self.w,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            r.time_s,
+            r.mobilised,
+            r.moving,
+            r.suspended,
+            r.deposited,
+            r.past_bed,
+            r.collected,
+            r.excluded,
+            r.travelled_far,
+            r.furthest_m,
+            stretches.join(",")
         )?;
         self.w.flush()
     }

@@ -1,8 +1,9 @@
 //! Files a run leaves behind: the gauge time series (CSV), particle snapshots (VTK), the
-//! plot of the final bed, the gauges' and the eroded mass's time series (PNG) and a sweep's
-//! chart of eroded mass (PNG).
+//! plot of the final bed, the gauges', the eroded mass's and the sediment budget's time series
+//! (PNG) and a sweep's chart of eroded mass (PNG).
 
 pub mod bed_plot;
+pub mod budget_plot;
 pub mod csv;
 pub mod inflow;
 pub mod outputs;

@@ -1,12 +1,13 @@
 //! The files a run writes as it goes (`simulate`, and `run --out`): gauges.csv, profile.csv,
-//! bed_profile.csv, eroded_mass.csv and particle snapshots.
+//! bed_profile.csv, eroded_mass.csv, sediment_budget.csv and particle snapshots.
 
 use crate::adapters::files::{
-    csv::{BedProfileCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
+    csv::{BedProfileCsv, BudgetCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
     vtk,
 };
 use anyhow::{Context, Result};
-use flume_solver::{Case, Observations, Simulation};
+use flume_solver::budget::{BudgetRow, SedimentBudget};
+use flume_solver::{Case, Observations, Particles, Simulation};
 use std::fs::{self, File};
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
@@ -36,7 +37,17 @@ pub struct OutputFiles {
     bed_profile: Option<(PathBuf, BedProfileCsv<BufWriter<File>>)>,
     /// eroded_mass.csv, for an open flume.
     eroded: Option<(PathBuf, ErodedMassCsv<BufWriter<File>>)>,
+    /// sediment_budget.csv, for an open flume with a sediment, and the budget's rows so far.
+    budget: Option<Budget>,
     snapshot_every: Option<u64>,
+}
+
+/// The sediment budget of a run and its file.
+struct Budget {
+    path: PathBuf,
+    csv: BudgetCsv<BufWriter<File>>,
+    books: SedimentBudget,
+    rows: Vec<BudgetRow>,
 }
 
 impl OutputFiles {
@@ -45,7 +56,14 @@ impl OutputFiles {
         self.bed_profile.is_some()
     }
 
-    pub fn create(dir: &Path, case: &Case, snapshot_every: Option<u64>) -> Result<OutputFiles> {
+    /// The files of `case`, whose particles at the start are `initial` (the sediment budget
+    /// follows each grain from where it was generated).
+    pub fn create(
+        dir: &Path,
+        case: &Case,
+        initial: &Particles,
+        snapshot_every: Option<u64>,
+    ) -> Result<OutputFiles> {
         fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory {}", dir.display()))?;
         let csv_path = dir.join("gauges.csv");
@@ -73,6 +91,20 @@ impl OutputFiles {
             Some(_) => Some(create_csv(dir, "eroded_mass.csv", ErodedMassCsv::new)?),
             None => None,
         };
+        let budget = match SedimentBudget::new(case, initial) {
+            Some(books) => {
+                let edges = books.stretch_edges_m();
+                let (path, csv) =
+                    create_csv(dir, "sediment_budget.csv", |w| BudgetCsv::new(w, &edges))?;
+                Some(Budget {
+                    path,
+                    csv,
+                    books,
+                    rows: Vec::new(),
+                })
+            }
+            None => None,
+        };
         Ok(OutputFiles {
             dir: dir.to_path_buf(),
             csv_path,
@@ -80,6 +112,7 @@ impl OutputFiles {
             profile,
             bed_profile,
             eroded,
+            budget,
             snapshot_every,
         })
     }
@@ -104,10 +137,29 @@ impl OutputFiles {
             csv.row(&obs)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
+        if let Some(b) = &mut self.budget {
+            let particles = sim
+                .read_particles()
+                .context("cannot read the particles back for the sediment budget")?;
+            let regions = sim
+                .regions()
+                .context("cannot read the regions back for the sediment budget")?;
+            let excluded = sim.flume().map_or(0, |f| f.excluded_sediment);
+            let row = b.books.update(obs.time_s, &particles, &regions, excluded);
+            b.csv
+                .row(&row)
+                .with_context(|| format!("cannot write {}", b.path.display()))?;
+            b.rows.push(row);
+        }
         if self.snapshot_every.is_some_and(|n| k.is_multiple_of(n)) {
             self.snapshot(sim, &format!("particles_{k:04}.vtk"))?;
         }
         Ok(obs)
+    }
+
+    /// The sediment budget's rows so far, for its plot; empty without a sediment.
+    pub fn budget_rows(&self) -> &[BudgetRow] {
+        self.budget.as_ref().map_or(&[], |b| &b.rows)
     }
 
     /// Writes to a temporary name first, so a crash never leaves a truncated snapshot behind.

@@ -15,8 +15,8 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Pixel width of the plots, and height of one panel.
-const WIDTH: u32 = 1200;
-const PANEL_HEIGHT: u32 = 260;
+pub(super) const WIDTH: u32 = 1200;
+pub(super) const PANEL_HEIGHT: u32 = 260;
 const PREDICTED: RGBColor = RGBColor(40, 90, 200);
 const MEASURED: RGBColor = RGBColor(200, 80, 40);
 /// The residual line of gauge k (P1, P2, P3, then around again), none of them the level
@@ -28,7 +28,7 @@ const GAUGE_COLOURS: [RGBColor; 4] = [
     RGBColor(200, 160, 0),
 ];
 
-type Chart<'a, 'b> =
+pub(super) type Chart<'a, 'b> =
     ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// One gauge's levels at each output: time (s), predicted and measured (m), None where the
@@ -186,7 +186,7 @@ fn y_range(values: impl Iterator<Item = f64>, least: f64) -> std::ops::Range<f64
 }
 
 /// A panel's axes on `area`: its caption, the time axis to `t_end` and `y`.
-fn axes<'a, 'b: 'a>(
+pub(super) fn axes<'a, 'b: 'a>(
     area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
     caption: &str,
     y_desc: &str,
@@ -215,7 +215,7 @@ fn axes<'a, 'b: 'a>(
 }
 
 /// Draws each run of `line` in `colour`, the first labelled `label` for the legend.
-fn lines<'a, 'b: 'a>(
+pub(super) fn lines<'a, 'b: 'a>(
     chart: &mut Chart<'a, 'b>,
     line: Vec<Vec<(f64, f64)>>,
     colour: RGBColor,
@@ -233,7 +233,7 @@ fn lines<'a, 'b: 'a>(
     Ok(())
 }
 
-fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, text: bool) -> Drawn {
+pub(super) fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, text: bool) -> Drawn {
     if text {
         chart
             .configure_series_labels()
