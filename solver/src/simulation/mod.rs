@@ -4,6 +4,7 @@
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s). The inlet (discharges, their
 //! schedule, the particles it places) is in [`inflow`].
 
+mod chain;
 mod inflow;
 
 pub use inflow::{InflowSchedule, RefusedInflow};

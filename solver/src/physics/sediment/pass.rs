@@ -218,6 +218,23 @@ fn norm3(a: [f32; 3]) -> f32 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
+/// The Shields chain of one sediment particle ([`Rheology::shields_chain`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShieldsChain {
+    /// Eq. 26: a water particle within the support and a kernel mass of sediment below the
+    /// surface fraction of a particle's.
+    pub at_surface: bool,
+    /// Distance to the nearest water particle, m (infinite with none): the z of the log law.
+    pub z_m: f32,
+    /// That water particle's speed relative to this one, m/s: the u of the log law.
+    pub speed_m_per_s: f32,
+    pub u_star_m_per_s: f32,
+    /// Bed shear stress (Eq. 18), Pa; 0 away from the surface.
+    pub tau_b_pa: f32,
+    /// Critical bed shear stress on the local slope (Eqs. 16-17, 22-24), Pa.
+    pub tau_bcr_pa: f32,
+}
+
 /// The rheology pass of one run, with its constants worked out once: [`Rheology::add_pair`]
 /// and [`Rheology::finish`] are the one statement of the pass, which the brute-force
 /// [`rheology_pass`] and the CPU backend's cell-list loop both call.
@@ -405,6 +422,35 @@ impl<'a> Rheology<'a> {
         }
     }
 
+    /// The Shields chain (Eqs. 16-26) of a sediment particle from its sums: whether it lies at
+    /// the bed's surface, the nearest water particle's distance and speed relative to it, the
+    /// friction velocity of the log law there, and the bed shear stress against its critical
+    /// value on the local slope (infinite away from the surface, where Shields does not apply).
+    pub fn shields_chain(&self, s: &RheologySums) -> ShieldsChain {
+        let mat = &self.model.material;
+        let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
+        let speed = norm3(s.water_du);
+        let mut chain = ShieldsChain {
+            at_surface,
+            z_m: s.water_r,
+            speed_m_per_s: speed,
+            u_star_m_per_s: 0.0,
+            tau_b_pa: 0.0,
+            tau_bcr_pa: f32::INFINITY,
+        };
+        if at_surface {
+            let u_star = friction_velocity(speed, s.water_r, mat.ks_m(), mat.nu_w).u_star;
+            let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
+            let tau_bcr0 =
+                critical_bed_shear_stress(theta, mat.rho_s, mat.rho_w, self.g, mat.d50_m);
+            let k = slope_factors(s.normal, s.water_du, self.params.dim, mat.phi_rad);
+            chain.u_star_m_per_s = u_star;
+            chain.tau_b_pa = bed_shear_stress(mat.rho_w, u_star);
+            chain.tau_bcr_pa = sloped_critical_stress(tau_bcr0, k, 1.0);
+        }
+        chain
+    }
+
     /// Region, apparent viscosity and hold of a sediment particle of density `rho_i`.
     fn classify(
         &self,
@@ -421,21 +467,12 @@ impl<'a> Rheology<'a> {
             self.kappa_dp,
             skeleton_pressure(p, mat.rho_s, mat.rho_w),
         );
-        let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
-        let (tau_b, tau_bcr) = match (s.water_r, s.water_du) {
-            (z, u) if at_surface => {
-                let u_star = friction_velocity(norm3(u), z, mat.ks_m(), mat.nu_w).u_star;
-                let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
-                let tau_bcr0 =
-                    critical_bed_shear_stress(theta, mat.rho_s, mat.rho_w, self.g, mat.d50_m);
-                let k = slope_factors(s.normal, u, self.params.dim, mat.phi_rad);
-                (
-                    bed_shear_stress(mat.rho_w, u_star),
-                    sloped_critical_stress(tau_bcr0, k, 1.0),
-                )
-            }
-            _ => (0.0, f32::INFINITY),
-        };
+        let ShieldsChain {
+            at_surface,
+            tau_b_pa: tau_b,
+            tau_bcr_pa: tau_bcr,
+            ..
+        } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
         let region = if model.shields_only {
             classify_shields_only(at_surface, tau_b, tau_bcr, c_v)
