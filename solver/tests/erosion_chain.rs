@@ -12,12 +12,11 @@
 //! within 10 % of the threshold (the backend's regions are those of the last step's start, a
 //! tenth of a millimetre of motion before the particles read).
 //!
-//! The z of the log law is, as the code takes it, the distance between the grain's centre and
-//! the nearest water particle's, not that particle's height over the bed's surface half a dp
-//! above the grain's centre (`MODEL.md` says "at height z above the bed surface"): at dp = 1 cm
-//! it is 1.5-1.9 cm, and from the surface it would be about 0.5 cm less, which raises u* by
-//! about 7 % and tau_b by 14 % for the same u. The oracle follows the code there; the scour
-//! issue's account of the sand's path has to say which the paper meant.
+//! The z of the log law is the distance between the grain's centre and the nearest water
+//! particle's, as the paper's Section 2.5.1 says its DualSPHysics implementation stores it ("the
+//! closest water particle to a sediment particle is identified during the neighbour search ...
+//! and its distance to a sediment particle is stored"), the sediment surface being the grain
+//! that Eq. 26 marks: at dp = 1 cm it is 1.5-1.9 cm.
 //!
 //! Measured (the test prints them): at 5 s, 214 grains at the surface, 186 of them over the
 //! threshold, Shields numbers 0.05-0.07 against about 0.04; at 15 s, 233 at the surface and 3
