@@ -41,7 +41,8 @@ fn text(bytes: &[u8]) -> String {
 }
 
 /// Two roughnesses, given out of order: a row each in that order, each run to the end, with the
-/// eroded mass of Eq. 34 (particles times dp^2 rho_s, per metre), the chart, and the table.
+/// eroded mass of Eq. 34 (particles times dp^2 rho_s, per metre), the chart, and the table;
+/// each run the one `simulate` gives with that value.
 #[test]
 fn a_roughness_ladder_gives_a_row_per_value_in_order() {
     let dir = scratch("ladder");
@@ -75,8 +76,26 @@ fn a_roughness_ladder_gives_a_row_per_value_in_order() {
             "{kg_per_m} kg/m is not {particles} x dp^2 rho_s = {eq34}"
         );
         assert!((kg - kg_per_m * width).abs() <= 1e-9 * kg.max(1.0), "{r:?}");
-        assert!(r["steps"].parse::<u64>().unwrap() > 0, "{r:?}");
         collected += particles;
+    }
+    // Each run is the run `simulate` gives for the case with that value: as many steps and the
+    // same sand collected (runs are bit-identical on one backend and thread count).
+    for r in &rows {
+        let alone = dir.join(format!("simulate_{}", r[KEY]));
+        let set = format!("{KEY}={}", r[KEY]);
+        let out = Command::new(BIN)
+            .arg("simulate")
+            .arg(repo_file(CASE))
+            .args(["--set", &set, "--until", "0.3", "--no-snapshots", "--out"])
+            .arg(&alone)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let gauges = csv_rows(&alone.join("gauges.csv"));
+        let eroded = csv_rows(&alone.join("eroded_mass.csv"));
+        let (g, e) = (gauges.last().unwrap(), eroded.last().unwrap());
+        assert_eq!(r["steps"], g["step"], "{set}: sweep {r:?}, simulate {g:?}");
+        assert_eq!(r["eroded_particles"], e["eroded_particles"], "{set}");
     }
     // Without collected sand the mass check above would hold for any particle mass.
     assert!(collected > 0, "no sand reached the collector: {rows:?}");
