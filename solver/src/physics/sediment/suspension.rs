@@ -167,11 +167,6 @@ mod tests {
     }
 
     #[test]
-    fn threshold_value() {
-        assert_eq!(SUSPENSION_CONCENTRATION, 0.3);
-    }
-
-    #[test]
     fn classification_follows_the_flow_chart() {
         let dense = 0.6;
         let thin = 0.1;
