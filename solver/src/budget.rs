@@ -46,14 +46,6 @@ pub struct BudgetRow {
     pub mobilised_by_stretch: [u64; STRETCHES],
 }
 
-impl BudgetRow {
-    /// The five places a mobilised grain can be, summed: equal to `mobilised` when every grain
-    /// was put in exactly one.
-    pub fn accounted(&self) -> u64 {
-        self.moving + self.suspended + self.deposited + self.past_bed + self.collected
-    }
-}
-
 /// One grain's history.
 #[derive(Debug, Clone, Copy)]
 struct Grain {
@@ -117,9 +109,13 @@ impl SedimentBudget {
         self.edges_m
     }
 
-    /// The grains the run started with.
-    pub fn grains(&self) -> usize {
-        self.grains.len()
+    /// Forgets what the flow has moved: the run starts again from the particles as generated
+    /// (the twin's reset), so no grain is mobilised until the new run moves it.
+    pub fn restart(&mut self) {
+        for g in &mut self.grains {
+            g.mobilised = false;
+            g.last_x = g.start[0];
+        }
     }
 
     /// Takes the budget of `particles` (in id order, as `Simulation::read_particles` gives
@@ -152,15 +148,18 @@ impl SedimentBudget {
                 let p = particles.positions[g.id];
                 let (x, y) = (f64::from(p[0]), f64::from(p[1]));
                 g.last_x = x;
-                let region = regions.get(g.id).map(|&w| ParticleRegion::from_word(w));
+                let region = regions
+                    .get(g.id)
+                    .and_then(|&w| ParticleRegion::from_word(w).region);
                 let shifted = (x - g.start[0]).hypot(y - g.start[1]) > 0.5 * dp;
-                let yielded = region.and_then(|r| r.region).is_some_and(|r| {
-                    matches!(r, Region::Yielded | Region::BedLoad | Region::Suspended)
-                });
+                let yielded = matches!(
+                    region,
+                    Some(Region::Yielded | Region::BedLoad | Region::Suspended)
+                );
                 g.mobilised |= shifted || yielded;
                 if x > past_bed_x {
                     Place::PastBed
-                } else if region.and_then(|r| r.region) == Some(Region::Suspended) {
+                } else if region == Some(Region::Suspended) {
                     Place::Suspended
                 } else if yielded {
                     Place::Moving

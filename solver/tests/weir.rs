@@ -160,6 +160,8 @@ fn the_weir_passes_its_discharge_at_rehbocks_head_over_a_still_pool() {
 /// half a dp beyond its outermost particle, the crest as long as the wall's layers: the weir
 /// of a pool whose water ends before it.
 fn weir_as_generated(particles: &flume_solver::Particles, dp: f64, layers: u32) -> Weir {
+    // The floor is read under the pool's last half metre, clear of the walls over the inlet.
+    const POOL_FLOOR_M: f64 = 0.5;
     let walls = (0..particles.len()).filter(|&i| particles.is_wall(i));
     let water_end = (0..particles.len())
         .filter(|&i| particles.phase(i) == WATER)
@@ -171,7 +173,7 @@ fn weir_as_generated(particles: &flume_solver::Particles, dp: f64, layers: u32) 
         if x > water_end {
             crest = crest.max(y);
             face = face.min(x);
-        } else if x > water_end - 0.5 {
+        } else if x > water_end - POOL_FLOOR_M {
             floor = floor.max(y);
         }
     }

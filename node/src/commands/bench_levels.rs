@@ -29,7 +29,7 @@ use anyhow::{Context, Result, bail};
 use flume_solver::bed_contact::bed_contact;
 use flume_solver::config::GaugeConfig;
 use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, PitFlow, SideWalls, fixed_bed_overrides};
-use flume_solver::{Backend, Case, Observations, Simulation};
+use flume_solver::{Backend, Case, Observations, Particles, Simulation};
 use std::path::Path;
 use std::time::Instant;
 
@@ -156,8 +156,11 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
     );
     print_levels(case, channel, r, &history);
     print_flow(case, r, &history);
-    print_bed(&sim, case)?;
-    print_pool(&sim, case, channel, r, &history)?;
+    let particles = sim.read_particles()?;
+    // Particles come in id order, as the region words do.
+    let regions = sim.regions()?;
+    print_bed(&sim, case, &particles, &regions);
+    print_pool(case, channel, r, &history, &particles);
     Ok(())
 }
 
@@ -298,39 +301,35 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
 /// the velocity head of an even approach over the pool's depth. A surface current that
 /// crosses the pit without spreading down carries head a still pool would hold as level.
 fn print_pool(
-    sim: &Simulation,
     case: &Case,
     channel: &Channel,
     r: &LevelRun,
     history: &[(Books, Observations)],
-) -> Result<()> {
+    particles: &Particles,
+) {
     let Some(g) = case
         .observations
         .gauges
         .iter()
         .position(|g| g.name == "pool")
     else {
-        return Ok(());
+        return;
     };
     let Some(level) = mean_level(history, g, r.until_s - WINDOW_S, r.until_s) else {
-        return Ok(());
+        return;
     };
-    let particles = sim.read_particles()?;
     let water = case.sediment_phases().map_or(1, |(_, w)| w as u32 + 1);
     let (x, dp) = (
         case.observations.gauges[g].position_m[0],
         case.numerics.dp_m,
     );
-    let u: Vec<f64> = (0..particles.len())
+    let (sum_u, sum_u3) = (0..particles.len())
         .filter(|&i| particles.phase(i) == water)
         .filter(|&i| (f64::from(particles.positions[i][0]) - x).abs() < dp)
         .map(|i| f64::from(particles.vel_rho[i][0]))
-        .collect();
-    let (sum_u, sum_u3) = u
-        .iter()
         .fold((0.0, 0.0), |(a, b), v| (a + v, b + v * v * v));
     if sum_u <= 0.0 {
-        return Ok(());
+        return;
     }
     let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
     let q = r.m3_per_h / 3600.0 / width;
@@ -355,17 +354,13 @@ fn print_pool(
         1e3 * approach(head),
         1e3 * approach(sharp)
     );
-    Ok(())
 }
 
 /// The cushion under the flow and the held bed's push, column by column, at the run's end
 /// (`flume_solver::bed_contact`).
-fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
-    let particles = sim.read_particles()?;
-    // Particles come in id order, as the region words do.
-    let regions = sim.regions()?;
-    let Some(contact) = bed_contact(case, sim.derived(), &particles, &regions) else {
-        return Ok(());
+fn print_bed(sim: &Simulation, case: &Case, particles: &Particles, regions: &[u32]) {
+    let Some(contact) = bed_contact(case, sim.derived(), particles, regions) else {
+        return;
     };
     let mut table = Table::new([
         "x (m)",
@@ -413,5 +408,4 @@ fn print_bed(sim: &Simulation, case: &Case) -> Result<()> {
             .largest_gap_dp()
             .map_or("-".to_string(), |g| format!("{g:.2}"))
     );
-    Ok(())
 }

@@ -188,6 +188,9 @@ impl Worker {
                 let started = Instant::now();
                 self.sim = Simulation::new(self.backend.clone(), &self.case)
                     .map_err(|e| format!("cannot rebuild the case: {e}"))?;
+                if let Some(r) = &mut self.recorder {
+                    r.restart();
+                }
                 let mut report = self.report(started.elapsed().as_secs_f64(), 0, 0, None)?;
                 report.reset = true;
                 Ok(report)

@@ -9,7 +9,7 @@ impl Simulation {
     /// The Shields chain ([`ShieldsChain`]) of every sediment particle of `particles` (in id
     /// order, as [`Simulation::read_particles`] gives them), by index: the sums of the rheology
     /// pass over every other particle by brute force, then its Shields step, both the code the
-    /// CPU backend runs. None for a case without a sediment or the multiphase viscosity.
+    /// CPU backend runs. None for a case without a sediment.
     pub fn shields_chains(&self, particles: &Particles) -> Option<Vec<(usize, ShieldsChain)>> {
         let model = crate::uniform::sediment_model(&self.case, &self.derived)?;
         let params = self

@@ -137,13 +137,13 @@ impl OutputFiles {
             csv.row(&obs)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
+        let snapshot_due = self.snapshot_every.is_some_and(|n| k.is_multiple_of(n));
+        if self.budget.is_none() && !snapshot_due {
+            return Ok(obs);
+        }
+        // One read back serves the budget and the snapshot.
+        let (particles, regions) = read_state(sim)?;
         if let Some(b) = &mut self.budget {
-            let particles = sim
-                .read_particles()
-                .context("cannot read the particles back for the sediment budget")?;
-            let regions = sim
-                .regions()
-                .context("cannot read the regions back for the sediment budget")?;
             let excluded = sim.flume().map_or(0, |f| f.excluded_sediment);
             let row = b.books.update(obs.time_s, &particles, &regions, excluded);
             b.csv
@@ -151,10 +151,20 @@ impl OutputFiles {
                 .with_context(|| format!("cannot write {}", b.path.display()))?;
             b.rows.push(row);
         }
-        if self.snapshot_every.is_some_and(|n| k.is_multiple_of(n)) {
-            self.snapshot(sim, &format!("particles_{k:04}.vtk"))?;
+        if snapshot_due {
+            let name = format!("particles_{k:04}.vtk");
+            self.write_snapshot(sim, &name, &particles, &regions, &[])?;
         }
         Ok(obs)
+    }
+
+    /// The run starts again from its initial state (the twin's reset): the sediment budget
+    /// forgets what the flow had moved, and its rows start again.
+    pub fn restart(&mut self) {
+        if let Some(b) = &mut self.budget {
+            b.books.restart();
+            b.rows.clear();
+        }
     }
 
     /// The sediment budget's rows so far, for its plot; empty without a sediment.
@@ -162,19 +172,22 @@ impl OutputFiles {
         self.budget.as_ref().map_or(&[], |b| &b.rows)
     }
 
-    /// Writes to a temporary name first, so a crash never leaves a truncated snapshot behind.
-    pub fn snapshot(&self, sim: &Simulation, name: &str) -> Result<()> {
-        self.snapshot_marked(sim, name, &[])
+    /// A snapshot of the state as it is now whose `culprit` field is 1 for the particles of
+    /// ids `marked`.
+    pub fn snapshot_marked(&self, sim: &Simulation, name: &str, marked: &[u32]) -> Result<()> {
+        let (particles, regions) = read_state(sim)?;
+        self.write_snapshot(sim, name, &particles, &regions, marked)
     }
 
-    /// A snapshot whose `culprit` field is 1 for the particles of ids `marked`.
-    pub fn snapshot_marked(&self, sim: &Simulation, name: &str, marked: &[u32]) -> Result<()> {
-        let particles = sim
-            .read_particles()
-            .context("cannot read the particles back from the GPU")?;
-        let regions = sim
-            .regions()
-            .context("cannot read the particle regions back from the GPU")?;
+    /// Writes to a temporary name first, so a crash never leaves a truncated snapshot behind.
+    fn write_snapshot(
+        &self,
+        sim: &Simulation,
+        name: &str,
+        particles: &Particles,
+        regions: &[u32],
+        marked: &[u32],
+    ) -> Result<()> {
         let path = self.dir.join(name);
         let tmp = self.dir.join(format!("{name}.part"));
         let title = format!(
@@ -185,8 +198,19 @@ impl OutputFiles {
         );
         let file =
             File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
-        vtk::write_particles(BufWriter::new(file), &title, &particles, &regions, marked)
+        vtk::write_particles(BufWriter::new(file), &title, particles, regions, marked)
             .and_then(|()| fs::rename(&tmp, &path))
             .with_context(|| format!("cannot write {}", path.display()))
     }
+}
+
+/// The particles and their region words as they are now.
+fn read_state(sim: &Simulation) -> Result<(Particles, Vec<u32>)> {
+    let particles = sim
+        .read_particles()
+        .context("cannot read the particles back from the backend")?;
+    let regions = sim
+        .regions()
+        .context("cannot read the particle regions back from the backend")?;
+    Ok((particles, regions))
 }
