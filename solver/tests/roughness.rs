@@ -1,0 +1,154 @@
+//! The mechanism of the paper's Figure 10 (Zubeldia et al. 2018, Section 3.2): a rougher bed
+//! (larger ks/d50) gives a larger friction velocity for the same near-bed flow (Eqs. 19-21), a
+//! larger Shields number, and so more sand carried further.
+//!
+//! The ULBRA flume at the paper's dp = 4 mm, shortened to a bed of 0.8 m (x = 0.1-0.9 m, the
+//! sill and the collector pit behind it, as in the bundled case), from its dry start to 6 s: the
+//! front crosses the dry bed in about 3 s, the sheet of grains it sets moving has come to rest by
+//! 5 s (ks/d50 = 1 and 3; at 7 it still creeps). At dp = 1 cm the flow moves no grain further
+//! than 3 cm, so the CI-size flume cannot show it. Three runs, ks/d50 = 1, 3 and 7, on the CPU
+//! backend (about a minute each on 2 cores).
+//!
+//! Each run's sand is followed by id (`flume_solver::budget`): the grains carried further than
+//! the budget's `FAR_M` (10 cm, its `travelled_far`), and the sand that crossed a fixed section
+//! of the bed, averaged over a section every 1 cm along it (the bed-load volume the flow carried
+//! past a section).
+//!
+//! Measured (the test prints them), at 6 s: 69 / 68 / 85 grains over 10 cm for ks/d50 = 1 / 3 /
+//! 7, mean section crossing 19.4 / 20.4 / 22.2 grains, collected 2 / 2 / 5. The sheet's travel
+//! is sensitive to the smallest perturbation: the same ks/d50 = 1 run with outputs every 0.5 s
+//! (steps shortened to land on them) carried 42 grains over 10 cm by 6 s, not 69; ks/d50 = 3,
+//! 65; 7, 96. So ks/d50 = 1 and 3 are not told apart beyond that spread here, and the test asserts
+//! only what stands above it: ks/d50 = 7 carries several grains (5) more over 10 cm than either,
+//! and more sand past a section than 1. The margin is the issue's "several grains", not fitted.
+
+mod common;
+
+use common::case_path;
+use flume_solver::budget::{BudgetRow, SedimentBudget};
+use flume_solver::config::{CollectorConfig, ProfileConfig, WallBlock};
+use flume_solver::{Backend, Case, Particles, Simulation};
+use std::collections::HashMap;
+
+const BED_START_M: f64 = 0.1;
+const BED_END_M: f64 = 0.9;
+const END_S: f64 = 6.0;
+
+/// The bundled ULBRA case at its own dp (4 mm), its bed 0.8 m long.
+fn short_flume(ks_over_d50: f64) -> Case {
+    let mut c = Case::from_path(&case_path("../launch_configs/ulbra_flume.yaml")).expect("parses");
+    assert_eq!(c.numerics.dp_m, 0.004, "the paper's dp");
+    let pit_end = BED_END_M + 0.2;
+    c.domain.max_m[0] = pit_end;
+    c.walls.blocks[2] = WallBlock {
+        min_m: vec![BED_END_M, 0.0],
+        max_m: vec![BED_END_M + 0.03, 0.055],
+    };
+    c.fluid_blocks[0].max_m[0] = BED_END_M;
+    let flume = c.open_flume.as_mut().expect("an open flume");
+    flume.collector = CollectorConfig {
+        x_min_m: BED_END_M + 0.02,
+        x_max_m: pit_end,
+        y_max_m: 0.05,
+    };
+    flume.reservoir_particles = 6000;
+    c.observations.gauges.truncate(1);
+    c.observations.profile = Some(ProfileConfig {
+        x_min_m: 0.05,
+        x_max_m: BED_END_M - 0.05,
+        columns: 9,
+        y_m: 0.0,
+    });
+    let (sand, _) = c.sediment_phases().expect("sand in water");
+    c.phases[sand]
+        .sediment
+        .as_mut()
+        .expect("a sediment")
+        .ks_over_d50 = ks_over_d50;
+    c
+}
+
+/// Sand grains' x by id.
+fn sand_x(p: &Particles, sand_phase: u32) -> HashMap<u32, f64> {
+    (0..p.len())
+        .filter(|&i| p.phase(i) == sand_phase)
+        .map(|i| (p.ids[i], f64::from(p.positions[i][0])))
+        .collect()
+}
+
+/// Sand that crossed each section x = BED_START + 1 cm, 2 cm, ... of the bed downstream
+/// (a grain no longer sand has left the bed over its end), averaged over the sections.
+fn mean_section_crossing(start: &HashMap<u32, f64>, end: &HashMap<u32, f64>) -> f64 {
+    let sections: Vec<f64> = (1..80).map(|k| BED_START_M + 0.01 * f64::from(k)).collect();
+    let crossed: usize = sections
+        .iter()
+        .map(|&s| {
+            start
+                .iter()
+                .filter(|&(id, &x0)| x0 < s && end.get(id).is_none_or(|&x1| x1 >= s))
+                .count()
+        })
+        .sum();
+    crossed as f64 / sections.len() as f64
+}
+
+struct Run {
+    ks_over_d50: f64,
+    row: BudgetRow,
+    crossing: f64,
+}
+
+fn run(ks_over_d50: f64) -> Run {
+    let case = short_flume(ks_over_d50);
+    let sand_phase = case.sediment_phases().expect("sand").0 as u32 + 1;
+    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    let initial = sim.read_particles().expect("reads");
+    let mut books = SedimentBudget::new(&case, &initial).expect("a flume with sand");
+    sim.advance_to(END_S).expect("runs");
+    let now = sim.read_particles().expect("reads");
+    let regions = sim.regions().expect("regions");
+    let excluded = sim.flume().map_or(0, |f| f.excluded_sediment);
+    let row = books.update(END_S, &now, &regions, excluded);
+    let crossing = mean_section_crossing(&sand_x(&initial, sand_phase), &sand_x(&now, sand_phase));
+    Run {
+        ks_over_d50,
+        row,
+        crossing,
+    }
+}
+
+#[test]
+fn a_rough_bed_carries_more_sand_further_than_a_smooth_one_at_the_papers_dp() {
+    let runs: Vec<Run> = [1.0, 3.0, 7.0].into_iter().map(run).collect();
+    for r in &runs {
+        println!(
+            "ks/d50 {}: mobilised {}, over 10 cm {}, mean section crossing {:.1}, \
+             collected {}, furthest {:.3} m",
+            r.ks_over_d50,
+            r.row.mobilised,
+            r.row.travelled_far,
+            r.crossing,
+            r.row.collected,
+            r.row.furthest_m
+        );
+    }
+    let rough = &runs[2];
+    for r in &runs[..2] {
+        assert!(
+            rough.row.travelled_far >= r.row.travelled_far + 5,
+            "ks/d50 {} carries {} grains over 10 cm, ks/d50 {} {}: not several more",
+            rough.ks_over_d50,
+            rough.row.travelled_far,
+            r.ks_over_d50,
+            r.row.travelled_far
+        );
+    }
+    assert!(
+        rough.crossing > runs[0].crossing,
+        "ks/d50 {}: {:.1} grains crossed a section, ks/d50 {}: {:.1}",
+        rough.ks_over_d50,
+        rough.crossing,
+        runs[0].ks_over_d50,
+        runs[0].crossing
+    );
+}
