@@ -18,16 +18,26 @@ from collections import defaultdict
 
 def fronts(run_dir, depth_m):
     """{time_s: front x in m, or None} of one run."""
+    path = f"{run_dir}/bed_profile.csv"
+    try:
+        return profile_fronts(path, depth_m)
+    except OSError as e:
+        sys.exit(f"cannot read {path}: {e.strerror} (a directory `flume-twin simulate` wrote?)")
+    except (KeyError, ValueError) as e:
+        sys.exit(f"{path}: not a bed profile (time_s,x_m,zb_m,zs_m,zw_m): {e!r}")
+
+
+def profile_fronts(path, depth_m):
     columns = defaultdict(list)
-    with open(f"{run_dir}/bed_profile.csv", newline="") as f:
+    with open(path, newline="") as f:
         for row in csv.DictReader(f):
             columns[float(row["time_s"])].append(row)
     if not columns:
-        sys.exit(f"{run_dir}/bed_profile.csv holds no rows")
+        sys.exit(f"{path} holds no rows")
     first = columns[min(columns)]
     bed_top = max((float(r["zs_m"]) for r in first if r["zs_m"]), default=None)
     if bed_top is None:
-        sys.exit(f"{run_dir}: the first profile shows no sand")
+        sys.exit(f"{path}: the first profile shows no sand")
     out = {}
     for t, rows in columns.items():
         wet = [

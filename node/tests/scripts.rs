@@ -49,3 +49,33 @@ fn water_front_finds_the_furthest_column_with_water_over_the_bed() {
     assert_eq!(rows, ["0.0,,", "1.0,0.100,0.100", "2.0,0.300,"], "{text}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A run directory without a bed profile, or a file that is not one, is refused by name.
+#[test]
+fn water_front_names_what_it_cannot_read() {
+    let dir = std::env::temp_dir().join(format!("flume-front-bad-{}", std::process::id()));
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).expect("dir");
+    std::fs::write(bad.join("bed_profile.csv"), "time_s,x_m\n0,zero\n").expect("file");
+    let run = |arg: &std::path::Path| {
+        Command::new("python3")
+            .arg(repo_file("scripts/water_front.py"))
+            .arg(arg)
+            .output()
+            .expect("python3 runs")
+    };
+    for (arg, says) in [
+        (dir.join("missing"), "cannot read"),
+        (bad.clone(), "not a bed profile"),
+    ] {
+        let out = run(&arg);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{} was read", arg.display());
+        assert!(
+            err.contains(says) && err.contains("bed_profile.csv"),
+            "{err}"
+        );
+        assert!(!err.contains("Traceback"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -76,10 +76,11 @@ fn sand_x(p: &Particles, sand_phase: u32) -> HashMap<u32, f64> {
         .collect()
 }
 
-/// Sand that crossed each section x = BED_START + 1 cm, 2 cm, ... of the bed downstream
-/// (a grain no longer sand has left the bed over its end), averaged over the sections.
+/// Sand that crossed each section of the bed 1 cm apart (its ends excluded) downstream (a
+/// grain no longer sand has left the bed over its end), averaged over the sections.
 fn mean_section_crossing(start: &HashMap<u32, f64>, end: &HashMap<u32, f64>) -> f64 {
-    let sections: Vec<f64> = (1..80).map(|k| BED_START_M + 0.01 * f64::from(k)).collect();
+    let n = ((BED_END_M - BED_START_M) / 0.01).round() as u32;
+    let sections: Vec<f64> = (1..n).map(|k| BED_START_M + 0.01 * f64::from(k)).collect();
     let crossed: usize = sections
         .iter()
         .map(|&s| {
