@@ -166,6 +166,7 @@ mod tests {
                     y_max_m: 0.05,
                 },
                 bottom_outlet: None,
+                sill: None,
                 reservoir_particles: 100,
             },
             inflow_m3_per_s: q,

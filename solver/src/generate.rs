@@ -91,6 +91,18 @@ fn wall_box(case: &Case, lo: &[i64], hi: &[i64]) -> (Vec<i64>, Vec<i64>) {
     (wlo, whi)
 }
 
+/// The case's wall blocks and the open flume's sill, (min, max) in m.
+fn wall_blocks(case: &Case) -> impl Iterator<Item = (Vec<f64>, Vec<f64>)> + '_ {
+    let sill = case
+        .sill_block()
+        .map(|(min, max)| (min.to_vec(), max.to_vec()));
+    case.walls
+        .blocks
+        .iter()
+        .map(|b| (b.min_m.clone(), b.max_m.clone()))
+        .chain(sill)
+}
+
 fn block_bounds(case: &Case, min: &[f64], max: &[f64]) -> (Vec<i64>, Vec<i64>) {
     let dp = case.numerics.dp_m;
     let lo = min
@@ -142,8 +154,8 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
             push_wall(p, &mut out);
         }
     });
-    for block in &case.walls.blocks {
-        let (blo, bhi) = block_bounds(case, &block.min_m, &block.max_m);
+    for (min, max) in wall_blocks(case) {
+        let (blo, bhi) = block_bounds(case, &min, &max);
         for_each_point(&blo, &bhi, |p| {
             if taken.insert(p.to_vec()) {
                 push_wall(p, &mut out);
@@ -269,9 +281,12 @@ pub fn count(case: &Case) -> u64 {
     let mut n = boxes(&wlo, &whi) - boxes(&inner_lo, &inner_hi);
     // Wall and fluid blocks: an upper bound when blocks overlap, exact otherwise; it only
     // guards limits.
-    let blocks = case.walls.blocks.iter().map(|b| (&b.min_m, &b.max_m));
-    for (min, max) in blocks.chain(case.fluid_blocks.iter().map(|b| (&b.min_m, &b.max_m))) {
-        let (blo, bhi) = block_bounds(case, min, max);
+    let fluid = case
+        .fluid_blocks
+        .iter()
+        .map(|b| (b.min_m.clone(), b.max_m.clone()));
+    for (min, max) in wall_blocks(case).chain(fluid) {
+        let (blo, bhi) = block_bounds(case, &min, &max);
         let clo: Vec<i64> = blo.iter().zip(&inner_lo).map(|(a, b)| *a.max(b)).collect();
         let chi: Vec<i64> = bhi.iter().zip(&inner_hi).map(|(a, b)| *a.min(b)).collect();
         n += boxes(&clo, &chi);

@@ -152,7 +152,7 @@ pub enum PitFlow {
 pub struct Channel {
     /// The inlet wall, m along the flume.
     pub x_inlet_m: f64,
-    /// Where the bed (and any sill at its level) ends over the collector pit, m.
+    /// Where the bed and its sill end over the collector pit, m.
     pub x_bed_end_m: f64,
     /// The bed's surface, m above the floor of the flume's frame.
     pub bed_m: f64,
@@ -255,10 +255,11 @@ impl Channel {
                 case.name
             ));
         };
-        // The bed ends where the last block at its level does (a sill in front of the pit).
+        // The bed ends where the sill in front of the pit does, or the last block at its level.
         let x_bed_end = beds
             .iter()
             .map(|b| b.0)
+            .chain(flume.sill.iter().map(|s| s.x_max_m))
             .chain(
                 case.walls
                     .blocks
@@ -376,8 +377,9 @@ impl Channel {
 }
 
 /// The overrides (`Case::from_path_with`) that make `case`'s flume a clear-water one: its
-/// sediment blocks become wall blocks of the same shape, and the collector pit starts full of
-/// water (a case needs some fluid, and the pit fills before any water leaves over the weir).
+/// sediment blocks become wall blocks of the same shape, a sill becomes a wall block level with
+/// them (no sliding sheet to pass over it), and the collector pit starts full of water (a case
+/// needs some fluid, and the pit fills before any water leaves over the weir).
 pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
     let channel = Channel::from_case(case)?;
     let water = case
@@ -394,11 +396,18 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
     let block = |min: &[f64], max: &[f64]| format!("{{{}}}", bounds(min, max));
     let fluid =
         |phase: &str, min: &[f64], max: &[f64]| format!("{{phase: {phase}, {}}}", bounds(min, max));
+    let sill = case
+        .open_flume
+        .as_ref()
+        .and_then(|f| f.sill.as_ref())
+        .zip(case.bed_top_m())
+        .map(|(s, top)| ([s.x_min_m, case.domain.min_m[1]], [s.x_max_m, top]));
     let walls: Vec<String> = case
         .walls
         .blocks
         .iter()
         .map(|w| block(&w.min_m, &w.max_m))
+        .chain(sill.iter().map(|(min, max)| block(min, max)))
         .chain(
             case.fluid_blocks
                 .iter()
@@ -415,10 +424,14 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
         .map(|b| fluid(&b.phase, &b.min_m, &b.max_m))
         .chain([fluid(&water.name, &pit, &crest)])
         .collect();
-    Ok(vec![
+    let mut overrides = vec![
         format!("walls.blocks=[{}]", walls.join(", ")),
         format!("fluid_blocks=[{}]", fluids.join(", ")),
-    ])
+    ];
+    if sill.is_some() {
+        overrides.push("open_flume.sill=null".into());
+    }
+    Ok(overrides)
 }
 
 #[cfg(test)]

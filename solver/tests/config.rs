@@ -238,6 +238,18 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
             "open_flume.inflow_m3_per_s",
             ">= 0",
         ),
+        (
+            "sill: { x_min_m: 2.2, x_max_m: 2.23 }",
+            "sill: { x_min_m: 2.2, x_max_m: 2.201 }",
+            "open_flume.sill",
+            "at least dp thick",
+        ),
+        (
+            "max_m: [2.2, 0.055]",
+            "max_m: [2.2, 0.006]",
+            "open_flume.sill",
+            "no row under its top",
+        ),
     ] {
         assert!(ULBRA.contains(from), "{from}");
         let (f, r) = refused(&ULBRA.replace(from, to));
@@ -302,6 +314,31 @@ fn an_open_flume_parks_its_reservoir_above_the_flow() {
     }
     assert_eq!(n, f.reservoir_particles as usize);
     assert!(count(&c) as usize >= p.len(), "count is an upper bound");
+}
+
+/// The sill's top row stands one row under the sand's top row whatever the dp, though the
+/// nominal 5.5 cm bed's top row is 0.05 m at dp = 1 cm, 0.049 m at 7 mm and 0.052 m at 4 mm.
+#[test]
+fn the_sill_crest_stands_a_row_under_the_sand_at_every_dp() {
+    for dp in [0.01, 0.007, 0.004] {
+        let mut c = launch_config("ulbra_flume.yaml");
+        c.numerics.dp_m = dp;
+        let p = generate(&c, &derive(&c));
+        let top = |phase: u32, x: (f32, f32)| {
+            (0..p.len())
+                .filter(|&i| p.phase(i) == phase && (x.0..x.1).contains(&p.positions[i][0]))
+                .map(|i| f64::from(p.positions[i][1]))
+                .fold(f64::MIN, f64::max)
+        };
+        let sand = top(2, (2.0, 2.2));
+        let sill = top(WALL_PHASE, (2.2, 2.23));
+        let bed = (0.055 / dp + 1e-6).floor() * dp;
+        assert!((sand - bed).abs() < 1e-6, "dp {dp}: sand's top row {sand}");
+        assert!(
+            (sill - (bed - dp)).abs() < 1e-6,
+            "dp {dp}: sill's top row {sill}"
+        );
+    }
 }
 
 #[test]

@@ -89,7 +89,7 @@ pub fn printed(out: &std::process::Output) -> String {
     )
 }
 
-/// The ULBRA flume at CI size (dp = 1 cm, 4,585 particles), as solver/tests/scour.rs builds
+/// The ULBRA flume at CI size (dp = 1 cm, 4,582 particles), as solver/tests/scour.rs builds
 /// it: the arguments after the case file.
 pub const ULBRA_CI: [&str; 4] = [
     "--set",

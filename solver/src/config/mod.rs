@@ -84,6 +84,9 @@ pub struct OpenFlume {
     /// reservoir flushed through its downstream wall; absent for a flume that spills over its weir.
     #[serde(default)]
     pub bottom_outlet: Option<BottomOutlet>,
+    /// The sill that ends the sand bed in front of the collector, as a sediment trap's lip.
+    #[serde(default)]
+    pub sill: Option<SillConfig>,
     /// Water particles parked at the start, for the inlet to draw on before any has left.
     pub reservoir_particles: u32,
 }
@@ -114,6 +117,18 @@ pub struct BottomOutlet {
     pub y_min_m: f64,
     pub y_max_m: f64,
     pub velocity_m_s: f64,
+}
+
+/// A wall from the floor, x from `x_min_m` to `x_max_m`, whose top row of particles stands one
+/// lattice row under the sediment bed's top row at every dp. The bed's top row is the layer
+/// that erodes and slides; the held row under it is the bed the sliding grains move on. A crest
+/// level with the top row would be a step one particle high in the sliding layer's path, where
+/// a real trap's lip, level with the bed's surface, lets them pass.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SillConfig {
+    pub x_min_m: f64,
+    pub x_max_m: f64,
 }
 
 /// A box, m: x from `x_min_m` to `x_max_m`, below `y_max_m`.
@@ -447,5 +462,26 @@ impl Case {
         let sediment = self.phases.iter().position(|p| p.sediment.is_some())?;
         let water = self.phases.iter().position(|p| p.sediment.is_none())?;
         Some((sediment, water))
+    }
+
+    /// Top of the highest sediment block, m, as written in the case.
+    pub fn bed_top_m(&self) -> Option<f64> {
+        let d = self.dim();
+        let (k, _) = self.sediment_phases()?;
+        self.fluid_blocks
+            .iter()
+            .filter(|b| b.phase == self.phases[k].name)
+            .map(|b| b.max_m[d - 1])
+            .reduce(f64::max)
+    }
+
+    /// The open flume's sill as a wall block (min, max), m, at this case's dp: its top is the
+    /// surface of the lattice row under the bed's top row (see [`SillConfig`]).
+    pub fn sill_block(&self) -> Option<([f64; 2], [f64; 2])> {
+        let sill = self.open_flume.as_ref()?.sill.as_ref()?;
+        let dp = self.numerics.dp_m;
+        let bed_row = (self.bed_top_m()? / dp + 1e-6).floor();
+        let crest = (bed_row - 1.0 + 0.5) * dp;
+        Some(([sill.x_min_m, self.domain.min_m[1]], [sill.x_max_m, crest]))
     }
 }

@@ -424,6 +424,25 @@ impl Case {
             }
             // Its bound, MAX_INLET_MACH c0, needs the derived c0: `derived::check_bottom_outlet`.
         }
+        if let Some(s) = &f.sill {
+            if !(s.x_min_m > lo[0] && s.x_max_m < hi[0] && s.x_max_m - s.x_min_m >= dp) {
+                return err(
+                    "sill",
+                    "must lie inside the flume and be at least dp thick".into(),
+                );
+            }
+            let Some(top) = self.bed_top_m() else {
+                return err("sill", "ends a sediment bed, and the case has none".into());
+            };
+            if top - lo[1] < 2.0 * dp {
+                return err(
+                    "sill",
+                    format!(
+                        "its crest stands a row under the bed's top, and a bed {top} m high has no row under its top at dp = {dp} m"
+                    ),
+                );
+            }
+        }
         // Sediment that starts in the collector would count as eroded at the first step.
         if let Some((k, _)) = self.sediment_phases() {
             let name = &self.phases[k].name;
