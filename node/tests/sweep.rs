@@ -96,6 +96,27 @@ fn a_roughness_ladder_gives_a_row_per_value_in_order() {
         let (g, e) = (gauges.last().unwrap(), eroded.last().unwrap());
         assert_eq!(r["steps"], g["step"], "{set}: sweep {r:?}, simulate {g:?}");
         assert_eq!(r["eroded_particles"], e["eroded_particles"], "{set}");
+        // The run's own files are simulate's, its sediment budget included, and the table's
+        // budget columns are the budget's last row.
+        let k = values.iter().position(|v| *v == r[KEY]).unwrap();
+        let run_dir = out_dir.join(format!("{:02}_{}", k + 1, r[KEY]));
+        for name in ["sediment_budget.csv", "eroded_mass.csv", "gauges.csv"] {
+            let ours = fs::read_to_string(run_dir.join(name)).unwrap();
+            let theirs = fs::read_to_string(alone.join(name)).unwrap();
+            assert_eq!(ours, theirs, "{set}: {name}");
+        }
+        let budget = csv_rows(&run_dir.join("sediment_budget.csv"));
+        let b = budget.last().unwrap();
+        let t: f64 = b["time_s"].parse().unwrap();
+        assert!((t - 0.3).abs() < 1e-9, "{set}: {b:?}");
+        for (table, books) in [
+            ("mobilised", "mobilised"),
+            ("travelled_far", "travelled_far"),
+            ("furthest_m", "furthest_m"),
+            ("eroded_particles", "collected"),
+        ] {
+            assert_eq!(r[table], b[books], "{set}: {table}");
+        }
     }
     // Without collected sand the mass check above would hold for any particle mass.
     assert!(collected > 0, "no sand reached the collector: {rows:?}");

@@ -1,13 +1,15 @@
 //! `flume-twin sweep`: one case run once per value of one field, each to the same time, and
 //! the eroded sediment mass each run ends with (the paper's Figure 10: eroded mass against
-//! ks/d50 in the ULBRA flume).
+//! ks/d50 in the ULBRA flume), with each run's files as `simulate` writes them.
 
-use crate::adapters::files::{csv::field, sweep_plot};
+use crate::adapters::files::outputs::OutputFiles;
+use crate::adapters::files::{budget_plot, csv::field, sweep_plot};
 use crate::adapters::progress;
 use crate::adapters::table::{Table, sig};
 use crate::cli::SweepArgs;
 use anyhow::{Context, Result, bail};
 use flume_solver::FlumeObservation;
+use flume_solver::budget::BudgetRow;
 use flume_solver::{Backend, Case, Simulation};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -62,6 +64,8 @@ struct Row {
     recoveries: u32,
     /// The flume's figures at the end, or why the run failed.
     outcome: Result<FlumeObservation, String>,
+    /// The sediment budget at the last output the run wrote (none without a sediment).
+    budget: Option<BudgetRow>,
 }
 
 impl Row {
@@ -178,7 +182,8 @@ fn run_ladder(
     let mut rows = Vec::new();
     for (k, ((value, case), &end_s)) in ladder.values.iter().zip(cases).zip(ends).enumerate() {
         let label = format!("{}={value}", ladder.key);
-        let row = run_one(backend, case, end_s, value, &label);
+        let run_dir = out_dir.join(run_dir_name(k, value));
+        let row = run_one(backend, case, end_s, value, &label, &run_dir);
         let outcome = match &row.outcome {
             Ok(f) => format!("eroded {} kg/m", sig(f.eroded_kg_per_m)),
             Err(e) => format!("FAILED: {e}"),
@@ -197,7 +202,31 @@ fn run_ladder(
     Ok(rows)
 }
 
-fn run_one(backend: &Backend, case: &Case, end_s: f64, value: &str, label: &str) -> Row {
+/// A run's folder: its place in the ladder and its value, with any character a file name
+/// should not hold as '_' (a value is YAML, and may be a list or a map).
+fn run_dir_name(k: usize, value: &str) -> String {
+    let safe: String = value
+        .chars()
+        .take(40)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{:02}_{safe}", k + 1)
+}
+
+fn run_one(
+    backend: &Backend,
+    case: &Case,
+    end_s: f64,
+    value: &str,
+    label: &str,
+    run_dir: &Path,
+) -> Row {
     let started = Instant::now();
     let mut row = Row {
         value: value.to_string(),
@@ -206,22 +235,28 @@ fn run_one(backend: &Backend, case: &Case, end_s: f64, value: &str, label: &str)
         steps: 0,
         recoveries: 0,
         outcome: Err(String::new()),
+        budget: None,
     };
-    row.outcome = run_case(backend, case, end_s, label, &mut row).map_err(|e| format!("{e:#}"));
+    row.outcome =
+        run_case(backend, case, end_s, label, run_dir, &mut row).map_err(|e| format!("{e:#}"));
     row.wall_s = started.elapsed().as_secs_f64();
     row
 }
 
-/// Runs `case` to `end_s` interval by interval, keeping in `row` how far it got, and reads the
-/// flume's figures at the end.
+/// Runs `case` to `end_s` interval by interval, writing its files to `run_dir` as `simulate`
+/// does (no snapshots) and keeping in `row` how far it got and its sediment budget, and reads
+/// the flume's figures at the end.
 fn run_case(
     backend: &Backend,
     case: &Case,
     end_s: f64,
     label: &str,
+    run_dir: &Path,
     row: &mut Row,
 ) -> Result<FlumeObservation> {
     let mut sim = Simulation::new(backend.clone(), case).context("cannot set up the simulation")?;
+    let mut files = OutputFiles::create(run_dir, case, sim.initial_particles(), None)?;
+    let mut last = files.record(&sim, 0)?;
     let interval_s = case.time.output_interval_s;
     // The last interval is shortened to land on end_s; 1e-9 keeps round-off from adding one.
     let intervals = ((end_s / interval_s) - 1e-9).ceil().max(1.0) as u64;
@@ -236,6 +271,8 @@ fn run_case(
             bar.finish_and_clear();
             return Err(e.into());
         }
+        last = files.record(&sim, k)?;
+        row.budget = files.budget_rows().last().cloned();
         row.time_s = target_s;
         progress::set_time(&bar, target_s);
         bar.set_message(format!(
@@ -244,11 +281,15 @@ fn run_case(
         ));
     }
     bar.finish_and_clear();
-    let obs = sim
-        .observe()
-        .context("cannot read the final observations")?;
-    row.recoveries = obs.recoveries;
-    obs.flume.context("the open flume reported no eroded mass")
+    if files.budget_rows().len() > 1 {
+        budget_plot::draw(
+            &run_dir.join("sediment_budget.png"),
+            label,
+            files.budget_rows(),
+        )?;
+    }
+    row.recoveries = last.recoveries;
+    last.flume.context("the open flume reported no eroded mass")
 }
 
 /// "t = 18 s", or the range when the runs stop at different times (a sweep of time.end_s).
@@ -262,8 +303,9 @@ fn time_label(ends: &[f64]) -> String {
     }
 }
 
-/// The varied value, the flume's figures (blank for a failed run) and how the run went.
-fn cells(r: &Row, number: impl Fn(f64) -> String) -> [String; 9] {
+/// The varied value, the flume's figures (blank for a failed run), the sediment budget at the
+/// last output (blank without one) and how the run went.
+fn cells(r: &Row, number: impl Fn(f64) -> String) -> [String; 12] {
     let (kg_per_m, kg, particles) = match &r.outcome {
         Ok(f) => (
             number(f.eroded_kg_per_m),
@@ -272,11 +314,22 @@ fn cells(r: &Row, number: impl Fn(f64) -> String) -> [String; 9] {
         ),
         Err(_) => Default::default(),
     };
+    let (mobilised, far, furthest) = match &r.budget {
+        Some(b) => (
+            b.mobilised.to_string(),
+            b.travelled_far.to_string(),
+            number(b.furthest_m),
+        ),
+        None => Default::default(),
+    };
     [
         r.value.clone(),
         kg_per_m,
         kg,
         particles,
+        mobilised,
+        far,
+        furthest,
         number(r.time_s),
         format!("{:.3}", r.wall_s),
         r.steps.to_string(),
@@ -291,6 +344,9 @@ fn print_table(key: &str, rows: &[Row]) {
         "eroded kg/m",
         "eroded kg",
         "eroded particles",
+        "mobilised",
+        "over 10 cm",
+        "furthest (m)",
         "t reached (s)",
         "wall (s)",
         "steps",
@@ -307,7 +363,7 @@ fn print_table(key: &str, rows: &[Row]) {
 /// sweep.csv: the varied key heads the first column; numbers at full precision.
 fn write_csv(path: &Path, key: &str, rows: &[Row]) -> Result<()> {
     let mut text = format!(
-        "{},eroded_kg_per_m,eroded_kg,eroded_particles,time_s,wall_s,steps,recoveries,status\n",
+        "{},eroded_kg_per_m,eroded_kg,eroded_particles,mobilised,travelled_far,furthest_m,time_s,wall_s,steps,recoveries,status\n",
         field(key)
     );
     for r in rows {
@@ -346,6 +402,14 @@ mod tests {
     }
 
     #[test]
+    fn a_run_folder_is_named_by_its_place_and_a_file_safe_value() {
+        assert_eq!(run_dir_name(0, "3"), "01_3");
+        assert_eq!(run_dir_name(9, "0.004"), "10_0.004");
+        assert_eq!(run_dir_name(2, "{x: [1, 2]}"), "03__x___1__2__");
+        assert_eq!(run_dir_name(0, &"9".repeat(50)).len(), 43);
+    }
+
+    #[test]
     fn a_failed_run_has_blank_figures_and_its_error() {
         let row = Row {
             value: "10".into(),
@@ -354,6 +418,7 @@ mod tests {
             steps: 40,
             recoveries: 3,
             outcome: Err("simulation blew up at t = 0.25 s, step 41".into()),
+            budget: None,
         };
         let dir = std::env::temp_dir().join(format!("flume-sweep-csv-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("temp dir");
@@ -362,7 +427,7 @@ mod tests {
         let text = std::fs::read_to_string(&path).expect("written");
         assert_eq!(
             text.lines().nth(1),
-            Some("10,,,,0.2,1.500,40,3,\"simulation blew up at t = 0.25 s, step 41\"")
+            Some("10,,,,,,,0.2,1.500,40,3,\"simulation blew up at t = 0.25 s, step 41\"")
         );
         std::fs::remove_dir_all(&dir).ok();
     }
