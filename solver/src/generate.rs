@@ -91,16 +91,23 @@ fn wall_box(case: &Case, lo: &[i64], hi: &[i64]) -> (Vec<i64>, Vec<i64>) {
     (wlo, whi)
 }
 
-/// The case's wall blocks and the open flume's sill, (min, max) in m.
-fn wall_blocks(case: &Case) -> impl Iterator<Item = (Vec<f64>, Vec<f64>)> + '_ {
-    let sill = case
-        .sill_block()
-        .map(|(min, max)| (min.to_vec(), max.to_vec()));
-    case.walls
+/// Lattice bounds of the case's wall blocks and of the open flume's sill: the sill is a block
+/// from the floor to the sediment bed's top, less its top row (`SillConfig`).
+fn wall_blocks(case: &Case) -> Vec<(Vec<i64>, Vec<i64>)> {
+    let mut blocks: Vec<_> = case
+        .walls
         .blocks
         .iter()
-        .map(|b| (b.min_m.clone(), b.max_m.clone()))
-        .chain(sill)
+        .map(|b| block_bounds(case, &b.min_m, &b.max_m))
+        .collect();
+    let sill = case.open_flume.as_ref().and_then(|f| f.sill.as_ref());
+    if let (Some(s), Some(top)) = (sill, case.bed_top_m()) {
+        let floor = case.domain.min_m[1];
+        let (lo, mut hi) = block_bounds(case, &[s.x_min_m, floor], &[s.x_max_m, top]);
+        hi[1] -= 1;
+        blocks.push((lo, hi));
+    }
+    blocks
 }
 
 fn block_bounds(case: &Case, min: &[f64], max: &[f64]) -> (Vec<i64>, Vec<i64>) {
@@ -154,8 +161,7 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
             push_wall(p, &mut out);
         }
     });
-    for (min, max) in wall_blocks(case) {
-        let (blo, bhi) = block_bounds(case, &min, &max);
+    for (blo, bhi) in wall_blocks(case) {
         for_each_point(&blo, &bhi, |p| {
             if taken.insert(p.to_vec()) {
                 push_wall(p, &mut out);
@@ -284,9 +290,8 @@ pub fn count(case: &Case) -> u64 {
     let fluid = case
         .fluid_blocks
         .iter()
-        .map(|b| (b.min_m.clone(), b.max_m.clone()));
-    for (min, max) in wall_blocks(case).chain(fluid) {
-        let (blo, bhi) = block_bounds(case, &min, &max);
+        .map(|b| block_bounds(case, &b.min_m, &b.max_m));
+    for (blo, bhi) in wall_blocks(case).into_iter().chain(fluid) {
         let clo: Vec<i64> = blo.iter().zip(&inner_lo).map(|(a, b)| *a.max(b)).collect();
         let chi: Vec<i64> = bhi.iter().zip(&inner_hi).map(|(a, b)| *a.min(b)).collect();
         n += boxes(&clo, &chi);

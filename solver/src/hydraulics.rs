@@ -243,22 +243,22 @@ impl Channel {
             .filter(|p| p.sediment.is_some())
             .map(|p| p.name.as_str())
             .collect();
-        let beds: Vec<(f64, f64)> = case
+        let bed_ends: Vec<f64> = case
             .fluid_blocks
             .iter()
             .filter(|b| sediment.contains(&b.phase.as_str()))
-            .map(|b| (b.max_m[0], b.max_m[1]))
+            .map(|b| b.max_m[0])
             .collect();
-        let Some(bed_nominal) = beds.iter().map(|b| b.1).reduce(f64::max) else {
+        let Some(bed_nominal) = case.bed_top_m() else {
             return Err(format!(
                 "{}: the 1-D reference needs a sediment bed",
                 case.name
             ));
         };
         // The bed ends where the sill in front of the pit does, or the last block at its level.
-        let x_bed_end = beds
+        let x_bed_end = bed_ends
             .iter()
-            .map(|b| b.0)
+            .copied()
             .chain(flume.sill.iter().map(|s| s.x_max_m))
             .chain(
                 case.walls

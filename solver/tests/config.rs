@@ -250,6 +250,12 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
             "open_flume.sill",
             "no row under its top",
         ),
+        (
+            "  - phase: sand\n    min_m: [0.1, 0.0]",
+            "  - phase: water\n    min_m: [0.1, 0.0]",
+            "open_flume.sill",
+            "ends a sediment bed",
+        ),
     ] {
         assert!(ULBRA.contains(from), "{from}");
         let (f, r) = refused(&ULBRA.replace(from, to));

@@ -474,14 +474,4 @@ impl Case {
             .map(|b| b.max_m[d - 1])
             .reduce(f64::max)
     }
-
-    /// The open flume's sill as a wall block (min, max), m, at this case's dp: its top is the
-    /// surface of the lattice row under the bed's top row (see [`SillConfig`]).
-    pub fn sill_block(&self) -> Option<([f64; 2], [f64; 2])> {
-        let sill = self.open_flume.as_ref()?.sill.as_ref()?;
-        let dp = self.numerics.dp_m;
-        let bed_row = (self.bed_top_m()? / dp + 1e-6).floor();
-        let crest = (bed_row - 1.0 + 0.5) * dp;
-        Some(([sill.x_min_m, self.domain.min_m[1]], [sill.x_max_m, crest]))
-    }
 }
