@@ -13,7 +13,7 @@
 
 pub use backend::{Backend, CPU_BACKEND};
 pub use config::{Case, ConfigError};
-pub use derived::{Derived, check_inflow, derive, inflow_limit_m3_per_s};
+pub use derived::{Derived, check_inflow, derive, inflow_limit_m3_per_s, monaghan_alpha};
 pub use engine::StageTime;
 pub use error::SolverError;
 pub use flume::BoundaryConditions;

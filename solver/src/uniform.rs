@@ -55,7 +55,14 @@ pub fn sim_params(
     let (viscosity_mode, alpha) = match case.numerics.viscosity {
         Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha),
         Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0),
-        Viscosity::Multiphase { alpha, .. } => (VISCOSITY_MULTIPHASE, alpha),
+        Viscosity::Multiphase {
+            alpha,
+            eddy_m2_per_s,
+            ..
+        } => (
+            VISCOSITY_MULTIPHASE,
+            alpha + derived::monaghan_alpha(eddy_m2_per_s, h, derived.c0, case.dim()),
+        ),
     };
     let sps_length2 = match case.numerics.viscosity {
         Viscosity::Multiphase { smagorinsky_cs, .. } => {

@@ -209,6 +209,18 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
             "0..=1",
         ),
         (
+            "viscosity: { method: multiphase, alpha: 0.02 }",
+            "viscosity: { method: multiphase, alpha: 0.02, eddy_m2_per_s: 4.0e-5 }",
+            "numerics.viscosity.eddy_m2_per_s",
+            "not both",
+        ),
+        (
+            "viscosity: { method: multiphase, alpha: 0.02 }",
+            "viscosity: { method: multiphase, eddy_m2_per_s: -4.0e-5 }",
+            "numerics.viscosity.eddy_m2_per_s",
+            "0..=0.01",
+        ),
+        (
             "rho0_kg_per_m3: 2710.0",
             "rho0_kg_per_m3: 900.0",
             "phases[1].rho0_kg_per_m3",

@@ -357,6 +357,12 @@ pub enum Viscosity {
         /// uses 0.12.
         #[serde(default)]
         smagorinsky_cs: f64,
+        /// The flow's kinematic eddy viscosity, m2/s, given to Monaghan's term in place of
+        /// `alpha`: alpha = 8 nu_t / (h c0), the viscosity the term acts as in 2-D (Monaghan
+        /// 2005, Rep. Prog. Phys. 68:1703), so the water is as viscous at every dp. 0 (the
+        /// default) for none; `hydraulics::Channel::eddy_viscosity_m2_per_s` gives a flume's.
+        #[serde(default)]
+        eddy_m2_per_s: f64,
     },
 }
 

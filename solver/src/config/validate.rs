@@ -208,6 +208,25 @@ impl Case {
                 format!("must be in 0..=1, got {smagorinsky_cs}"),
             );
         }
+        if let Viscosity::Multiphase {
+            alpha,
+            eddy_m2_per_s,
+            ..
+        } = n.viscosity
+        {
+            if !(eddy_m2_per_s.is_finite() && (0.0..=0.01).contains(&eddy_m2_per_s)) {
+                return err(
+                    "numerics.viscosity.eddy_m2_per_s",
+                    format!("must be in 0..=0.01, got {eddy_m2_per_s}"),
+                );
+            }
+            if eddy_m2_per_s > 0.0 && alpha != 0.0 {
+                return err(
+                    "numerics.viscosity.eddy_m2_per_s",
+                    format!("sets Monaghan's alpha itself; give it or alpha ({alpha}), not both"),
+                );
+            }
+        }
         if let Viscosity::Artificial { alpha } | Viscosity::Multiphase { alpha, .. } = n.viscosity
             && !(alpha.is_finite() && (0.0..=10.0).contains(&alpha))
         {

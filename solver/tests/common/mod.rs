@@ -92,8 +92,15 @@ pub fn reference_params(sim: &flume_solver::Simulation) -> flume_solver::physics
             CaseViscosity::Multiphase {
                 alpha,
                 smagorinsky_cs,
+                eddy_m2_per_s,
             } => Viscosity::Multiphase {
-                alpha: alpha as f32,
+                alpha: (alpha
+                    + flume_solver::monaghan_alpha(
+                        eddy_m2_per_s,
+                        derived.h,
+                        derived.c0,
+                        case.dim(),
+                    )) as f32,
                 sps_length2: (smagorinsky_cs * case.numerics.dp_m).powi(2) as f32,
             },
         },

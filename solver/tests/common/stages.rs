@@ -610,6 +610,7 @@ pub fn eddy_viscosity_case() -> Case {
     c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {
         alpha: 0.05,
         smagorinsky_cs: 0.12,
+        eddy_m2_per_s: 0.0,
     };
     c
 }
@@ -627,6 +628,7 @@ pub fn shields_only_case() -> Case {
     c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {
         alpha: 0.05,
         smagorinsky_cs: 0.0,
+        eddy_m2_per_s: 0.0,
     };
     c.numerics.clamp_negative_pressure = true;
     c
