@@ -10,15 +10,18 @@ use std::process::Command;
 
 /// Last sample of the session, s after its first.
 const SESSION_S: f64 = 75.0;
-/// Predicted against measured level at P2 and P3 once the flow is steady: 3 dp. Set after
+/// Predicted against measured level at P2 and P3 once the flow is steady: 3.5 dp. Set after
 /// seeing the twin's levels at this resolution: they rise for about 40 s and settle 2 to 3 cm
-/// above the session's (0.103 m at P2 against 0.0801 m at 2 m3/h, 0.111 against 0.0834 m at
-/// 2.5 m3/h, since the session is made by the 1-D reference of `flume_solver::hydraulics`),
-/// where the solver's 18 s test still holds 1.5 dp. The flow is two to four
-/// particles deep, and the water rides about a particle above the held bed and the weir's
-/// crest (DBC's gap), so the CI-size twin stores more water than the 1-D friction law of the
-/// session's model. This bound catches a level that drifts without end, not that bias.
-const LEVEL_TOLERANCE_M: f64 = 0.03;
+/// above the session's (0.103 m at P2 against 0.0793 m at 2 m3/h, 0.112 against 0.0823 m at
+/// 2.5 m3/h at the end, since the session is made by the 1-D reference of
+/// `flume_solver::hydraulics`), where the solver's 18 s test still holds 1.5 dp. The flow is
+/// two to four particles deep, and the water rides about a particle above the held bed and the
+/// weir's crest (DBC's gap), so the CI-size twin stores more water than the 1-D friction law of
+/// the session's model. This bound catches a level that drifts without end, not that bias. It
+/// was 3 dp until the reference took the current carried over the short collector pit, which
+/// lowered the session's levels by 1-2 mm: P2 then stood 3.02 cm over the session at 73 s.
+/// The case's own levels are the open part of the levels work (README, levels section).
+const LEVEL_TOLERANCE_M: f64 = 0.035;
 /// From when the levels are compared: the front passed P3 by 6 s at CI size, plus 4 s.
 const STEADY_FROM_S: f64 = 10.0;
 

@@ -1,7 +1,11 @@
 //! The 1-D reference for an open flume's steady water levels, from textbook hydraulics alone:
 //! what the twin's levels are checked against (`flume-twin bench --levels`) and what the
 //! synthetic sessions of `flume-twin make-session` are made from. Nothing here is fitted to a
-//! run of the SPH model.
+//! run of the SPH model. One choice came after the model was compared with it: the pit's limit
+//! by its length (below) replaced the expanded pit the reference was first fixed with, when
+//! the model's pool showed the current crossing it (its velocity profile, README's levels
+//! section); the rule is Eaton & Johnston's, and the same rule picks the expanded pit for a
+//! pit 88 cm long, where the model agreed with that limit.
 //!
 //! The flume, from downstream up (the ULBRA case's layout):
 //! - **The weir** at the downstream end: a rectangular-profile crest of height P above the
@@ -9,10 +13,14 @@
 //!   rating gives the pool's level, crest + H, for the unit discharge q ([`Weir::head_m`]):
 //!   at the model's dp the end wall's particle layers make a crest as long as the head is
 //!   high, a short-crested weir, rated as such ([`crest_coefficient`]).
-//! - **The collector pit** between the end of the bed and the weir: deep, slow water. The flow
-//!   leaves the bed into it over an abrupt drop, where it loses the Borda-Carnot head
-//!   `(V1 - V2)^2 / 2g` of an abrupt expansion (Chow 1959, Open-Channel Hydraulics): the level over the bed's end is the pool's,
-//!   plus `V2 (V2 - V1) / g`, a millimetre or two lower.
+//! - **The collector pit** between the end of the bed and the weir. The flow leaves the bed
+//!   into it over an abrupt drop. In a pit longer than the reattachment length behind such a
+//!   step it spreads down and slows before the weir, losing the Borda-Carnot head
+//!   `(V1 - V2)^2 / 2g` of an abrupt expansion (Chow 1959, Open-Channel Hydraulics): the level
+//!   over the bed's end is the pool's plus `V2 (V2 - V1) / g`. In a shorter one (the ULBRA
+//!   case's 27 cm behind a 5.5 cm step, 5 step heights against 7) the current crosses at the
+//!   crest's level and reaches the weir with its velocity head ([`PitFlow`]); the geometry
+//!   chooses which ([`REATTACHMENT_STEP_HEIGHTS`]).
 //! - **The bed**, horizontal, with the gradually varied flow `dh/dx = (S0 - Sf) / (1 - Fr^2)`
 //!   (Chow 1959) integrated upstream from the bed's end, S0 = 0. The friction slope is
 //!   Manning's, `Sf = n^2 V^2 / R^(4/3)`, with Strickler's `n = ks^(1/6) / 21.1` (Strickler
@@ -25,6 +33,7 @@
 //! miss by without a wall-shear term of its own.
 
 use crate::config::Case;
+use crate::physics::sediment::shields::KARMAN;
 
 /// Standard gravity, m/s2.
 pub const GRAVITY_M_PER_S2: f64 = 9.81;
@@ -130,6 +139,12 @@ pub enum SideWalls {
     /// Horton-Einstein.
     Glass { width_m: f64, manning_n: f64 },
 }
+
+/// The reattachment length of a turbulent flow over a backward-facing step, in step heights:
+/// 7 +/- 1 (Eaton & Johnston 1981, AIAA J. 19:1093, their review of the experiments). A pit
+/// shorter than this from the step to the weir is crossed by the current before it has spread
+/// down ([`PitFlow::Carried`]); a longer one stills it ([`PitFlow::Expanded`]).
+pub const REATTACHMENT_STEP_HEIGHTS: f64 = 7.0;
 
 /// How the flow off the bed's end meets the pool before the weir: the two limits between which
 /// a collector pit's flow lies.
@@ -273,20 +288,40 @@ impl Channel {
             .iter()
             .find_map(|p| p.sediment.as_ref())
             .map_or(1e-3, |s| s.ks_over_d50 * s.d50_m);
+        let weir = Weir {
+            x_m: face_in(hi[0], -1.0),
+            crest_m: top(flume.outlet_weir_m),
+            length_m: f64::from(case.walls.layers) * dp,
+            floor_m: face_in(lo[1], 1.0),
+        };
+        let (x_bed_end_m, bed_m) = (top(x_bed_end), top(bed_nominal));
+        let step_m = bed_m - weir.floor_m;
+        let pit = if weir.x_m - x_bed_end_m >= REATTACHMENT_STEP_HEIGHTS * step_m {
+            PitFlow::Expanded
+        } else {
+            PitFlow::Carried
+        };
         Ok(Channel {
             x_inlet_m: face_in(lo[0], 1.0),
-            x_bed_end_m: top(x_bed_end),
-            bed_m: top(bed_nominal),
+            x_bed_end_m,
+            bed_m,
             manning_n: strickler_n(ks_m),
             side_walls: SideWalls::None,
-            pit: PitFlow::Expanded,
-            weir: Weir {
-                x_m: face_in(hi[0], -1.0),
-                crest_m: top(flume.outlet_weir_m),
-                length_m: f64::from(case.walls.layers) * dp,
-                floor_m: face_in(lo[1], 1.0),
-            },
+            pit,
+            weir,
         })
+    }
+
+    /// The depth-averaged eddy viscosity of the steady flow of `q_m3_per_s` through a flume
+    /// `width_m` wide, m2/s: `kappa u* h / 6`, the mean over the depth of the parabolic profile
+    /// `kappa u* z (1 - z / h)` of a uniform open-channel flow (Rodi 1993, Turbulence Models
+    /// and Their Application in Hydraulics; Nezu & Nakagawa 1993), with h the mean depth of the
+    /// steady surface over the bed and `u* = sqrt(g h Sf)` its friction velocity there.
+    pub fn eddy_viscosity_m2_per_s(&self, q_m3_per_s: f64, width_m: f64) -> f64 {
+        let profile = self.steady(q_m3_per_s, width_m);
+        let h = profile.depths_m.iter().sum::<f64>() / profile.depths_m.len() as f64;
+        let u_star = (GRAVITY_M_PER_S2 * h * self.friction_slope(q_m3_per_s / width_m, h)).sqrt();
+        f64::from(KARMAN) * u_star * h / 6.0
     }
 
     /// The steady surface for the discharge `q_m3_per_s` through a flume `width_m` wide.
@@ -357,7 +392,14 @@ impl Channel {
     /// `-dh/dx = Sf / (1 - Fr^2)` at depth `h`: how fast the depth grows upstream.
     fn backwater_slope(&self, q: f64, h: f64) -> f64 {
         let v = q / h;
-        let sf = match self.side_walls {
+        let fr2 = (v * v / (GRAVITY_M_PER_S2 * h)).min(0.99);
+        self.friction_slope(q, h) / (1.0 - fr2)
+    }
+
+    /// Manning's friction slope `Sf` at depth `h` for the unit discharge `q`.
+    fn friction_slope(&self, q: f64, h: f64) -> f64 {
+        let v = q / h;
+        match self.side_walls {
             SideWalls::None => self.manning_n.powi(2) * v * v / h.powf(4.0 / 3.0),
             SideWalls::Glass {
                 width_m: b,
@@ -370,9 +412,7 @@ impl Channel {
                 let r = b * h / perimeter;
                 n * n * v * v / r.powf(4.0 / 3.0)
             }
-        };
-        let fr2 = (v * v / (GRAVITY_M_PER_S2 * h)).min(0.99);
-        sf / (1.0 - fr2)
+        }
     }
 }
 

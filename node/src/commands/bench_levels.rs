@@ -8,8 +8,8 @@
 //! - each gauge's mean level over the last 10 s against the reference, and its drift (the last
 //!   10 s' mean less the 10 s' before), and the same for a gauge added in the pool before the
 //!   weir, whose level is the weir's head alone; beside the reference, how it moves with the
-//!   glass walls' friction, with the pit's other limit (`PitFlow::Carried`: the current off the
-//!   bed crosses the pit without spreading) and with Strickler's n -/+20 %;
+//!   glass walls' friction, with the pit's other limit than the one its length chooses
+//!   (`hydraulics::PitFlow`) and with Strickler's n -/+20 %;
 //! - the discharge over the weir and the one the inlet placed, over the last 10 s, against the
 //!   discharge asked (particles parked at the outlet, dp^2 each per metre of width);
 //! - at the end, the pool gauge's column: what it passes, and the weir's head counted as energy
@@ -191,9 +191,12 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         ..channel.clone()
     }
     .steady(q, width);
-    // The other limit of the pit's flow: the current off the bed crosses it without spreading.
-    let carried = Channel {
-        pit: PitFlow::Carried,
+    // The pit's other limit than the one its length chooses (`hydraulics::PitFlow`).
+    let other_pit = Channel {
+        pit: match channel.pit {
+            PitFlow::Expanded => PitFlow::Carried,
+            PitFlow::Carried => PitFlow::Expanded,
+        },
         ..channel.clone()
     }
     .steady(q, width);
@@ -210,14 +213,20 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
     let head = channel.weir.head_m(q_unit);
     println!(
         "1-D reference on the generated geometry: bed {:.4} m, crest {:.4} m ({:.3} m long), \
-         head {:.1} mm (H / L = {:.2}; a thin plate's, Rehbock: {:.1} mm), Strickler n = {:.4}",
+         head {:.1} mm (H / L = {:.2}; a thin plate's, Rehbock: {:.1} mm), Strickler n = {:.4}, \
+         pit {:?} ({:.2} m behind a {:.3} m step); the flow's eddy viscosity kappa u* h / 6 = \
+         {:.2e} m2/s",
         channel.bed_m,
         channel.weir.crest_m,
         channel.weir.length_m,
         1e3 * head,
         head / channel.weir.length_m,
         1e3 * channel.weir.sharp_head_m(q_unit),
-        channel.manning_n
+        channel.manning_n,
+        channel.pit,
+        channel.weir.x_m - channel.x_bed_end_m,
+        channel.bed_m - channel.weir.floor_m,
+        channel.eddy_viscosity_m2_per_s(q, width),
     );
     let end = r.until_s;
     let mut table = Table::new([
@@ -228,7 +237,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         "model - ref (mm)",
         "drift (mm/10 s)",
         "glass walls (mm)",
-        "pit carried (mm)",
+        "other pit limit (mm)",
         "n -/+20 % (mm)",
     ]);
     for (g, gauge) in case.observations.gauges.iter().enumerate() {
@@ -248,7 +257,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
                     .map(|(a, b)| format!("{:+.1}", 1e3 * (a - b))),
             ),
             format!("{:+.1}", 1e3 * (glass.level_m(x) - want)),
-            format!("{:+.1}", 1e3 * (carried.level_m(x) - want)),
+            format!("{:+.1}", 1e3 * (other_pit.level_m(x) - want)),
             format!(
                 "{:+.1} / {:+.1}",
                 1e3 * (n_low.level_m(x) - want),

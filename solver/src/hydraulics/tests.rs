@@ -223,3 +223,43 @@ fn the_generated_geometry_sits_on_the_lattice() {
         assert!((c.weir.length_m - 3.0 * dp).abs() < 1e-12);
     }
 }
+
+/// Hand check of `kappa u* h / 6` on a bed 1 cm long, whose depth is the one over the bed's end
+/// (23.3 mm under the expanded pit at 2 m3/h, above): V = 0.2773 m/s, Manning's
+/// Sf = n^2 V^2 / h^(4/3) = 2.747e-3 for n = 0.01542 (ks = 1.2 mm), u* = sqrt(g h Sf) =
+/// 0.02506 m/s, nu_t = 0.41 x 0.02506 x 0.0233 / 6 = 3.99e-5 m2/s: 40 times water's.
+#[test]
+fn the_flows_eddy_viscosity_by_hand() {
+    let c = Channel {
+        x_inlet_m: 2.22,
+        ..ulbra(strickler_n(0.0012))
+    };
+    let nu_t = c.eddy_viscosity_m2_per_s(Q_2, WIDTH);
+    assert!((nu_t / 3.99e-5 - 1.0).abs() < 0.01, "{nu_t}");
+}
+
+/// The pit's limit follows its length against 7 step heights (Eaton & Johnston 1981): the
+/// bundled flume's 27 cm behind a 5.5 cm step is crossed by the current, a pit 88 cm long is
+/// not (the two pits `bench --levels` was run on; see the README's levels section).
+#[test]
+fn the_pits_length_chooses_its_limit() {
+    let mut case = crate::Case::from_path(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../launch_configs/ulbra_flume.yaml"
+    )))
+    .expect("the bundled case");
+    for dp in [0.01, 0.004] {
+        case.numerics.dp_m = dp;
+        let c = Channel::as_generated(&case).expect("a flume");
+        assert_eq!(c.pit, PitFlow::Carried, "dp {dp}");
+    }
+    assert_eq!(
+        Channel::from_case(&case).expect("a flume").pit,
+        PitFlow::Carried
+    );
+    case.domain.max_m[0] = 2.23 + 0.88;
+    assert_eq!(
+        Channel::from_case(&case).expect("a flume").pit,
+        PitFlow::Expanded
+    );
+}
