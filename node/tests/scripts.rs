@@ -79,3 +79,87 @@ fn water_front_names_what_it_cannot_read() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `bed_load.py` against Meyer-Peter & Mueller worked by hand. 2 m3/h over 86 mm (q =
+/// 6.460e-3 m2/s) 25 mm deep over sand of d50 = 0.4 mm, ks = 1.2 mm: U = 0.2584 m/s,
+/// ln(11 h / ks) = 5.4344, u* = 0.41 U / 5.4344 = 0.019495 m/s, theta = u*^2 / (1.71 g d50) =
+/// 0.05664, q* = 8 (0.05664 - 0.047)^1.5 = 7.572e-3, times sqrt(1.71 g d50^3) = 3.2766e-5 m2/s
+/// and 2,710 kg/m3: 6.723e-4 kg/m/s, 6.723e-3 kg/m over 10 s. A flow 40 mm deep (theta =
+/// 0.0187) moves nothing. The run's own collected mass is read over the same span.
+#[test]
+fn bed_load_integrates_meyer_peter_mueller_on_the_runs_depths() {
+    let dir = std::env::temp_dir().join(format!("flume-bedload-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    // The bed's top at 0.055 m: 25 mm of water from 0 to 10 s, then 40 mm; dry before 0.
+    std::fs::write(
+        dir.join("gauges.csv"),
+        "time_s,step,P3_m\n-1,0,0.055\n0,1,0.080\n5,2,0.080\n10,3,0.080\n15,4,0.095\n20,5,0.095\n",
+    )
+    .expect("gauges");
+    std::fs::write(
+        dir.join("eroded_mass.csv"),
+        "time_s,eroded_kg_per_m\n0,0.1\n5,0.2\n10,0.3\n15,0.3\n20,0.5\n",
+    )
+    .expect("eroded");
+    let out = Command::new("python3")
+        .arg(repo_file("scripts/bed_load.py"))
+        .arg(&dir)
+        .args(["--gauge", "P3", "--bed-m", "0.055"])
+        .output()
+        .expect("python3 runs");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{err}");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let total = |t: &str| -> f64 {
+        let row = text
+            .lines()
+            .find(|l| l.split(',').next() == Some(t))
+            .unwrap_or_else(|| panic!("no row at {t} s:\n{text}"));
+        row.split(',')
+            .nth(4)
+            .expect("mpm_kg_per_m")
+            .parse()
+            .expect("a number")
+    };
+    assert!((total("10") / 6.723e-3 - 1.0).abs() < 1e-3, "{text}");
+    // From 10 to 15 s the rate falls to nothing: half a trapezoid, 5 s x 6.723e-4 / 2.
+    assert!(
+        (total("15") / (6.723e-3 + 1.681e-3) - 1.0).abs() < 1e-3,
+        "{text}"
+    );
+    assert_eq!(total("15"), total("20"), "{text}");
+    assert!(err.contains("the run collected 0.400 kg/m"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A run directory without the gauge asked for, or without its files, is refused by name.
+#[test]
+fn bed_load_names_what_it_cannot_read() {
+    let dir = std::env::temp_dir().join(format!("flume-bedload-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("gauges.csv"), "time_s,P1_m\n0,0.08\n").expect("gauges");
+    std::fs::write(dir.join("eroded_mass.csv"), "time_s,eroded_kg_per_m\n0,0\n").expect("mass");
+    let run = |dir: &std::path::Path| {
+        Command::new("python3")
+            .arg(repo_file("scripts/bed_load.py"))
+            .arg(dir)
+            .args(["--gauge", "P3", "--bed-m", "0.055"])
+            .output()
+            .expect("python3 runs")
+    };
+    let no_gauge = run(&dir);
+    assert!(!no_gauge.status.success());
+    assert!(
+        String::from_utf8_lossy(&no_gauge.stderr).contains("no column ['P3_m']"),
+        "{}",
+        String::from_utf8_lossy(&no_gauge.stderr)
+    );
+    let missing = run(&dir.join("nowhere"));
+    assert!(!missing.status.success());
+    assert!(
+        String::from_utf8_lossy(&missing.stderr).contains("cannot read"),
+        "{}",
+        String::from_utf8_lossy(&missing.stderr)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -328,7 +328,6 @@ mod tests {
             let vel_rho = vec![[0.0, 0.0, 0.0, rho]];
             let forces = vec![[0.0, 0.0, 0.0, drho]];
             let (_, vel_h) = predictor(&ph, dt, &pos, &vel_rho, &forces);
-            assert_eq!(vel_h[0][3], rho + 0.5 * dt * drho);
             let (_, vel_new) = corrector(&ph, dt, &pos, &vel_rho, &vel_h, &forces);
             let exact = f64::from(rho) + f64::from(dt) * f64::from(drho);
             // A few ulps of ~1000.
