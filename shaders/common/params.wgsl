@@ -1,4 +1,4 @@
-// Simulation parameters shared by every stage; mirrored by `SimParams` in solver/src/gpu/params.rs
+// Simulation parameters shared by every stage; mirrored by `SimParams` in solver/src/contract/blocks.rs
 // (a test checks the two layouts agree). Lengths in m, times in s, densities in kg/m3.
 
 struct Phase {

@@ -14,7 +14,7 @@ struct ExcludedParticle {
     pad: u32,
 }
 
-// Mirrors `EXCLUDED_LOG_LEN` in solver/src/gpu/params.rs.
+// Mirrors `EXCLUDED_LOG_LEN` in solver/src/contract/blocks.rs.
 const EXCLUDED_LOG_LEN: u32 = 8u;
 
 struct StepState {

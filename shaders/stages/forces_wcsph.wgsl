@@ -17,7 +17,7 @@
 @group(0) @binding(7) var stress_b: texture_2d<f32>;
 
 const VISCOSITY_MULTIPHASE: u32 = 2u;
-// Mirrors BOUNDARY_GENERALISED of gpu/params.rs.
+// Mirrors BOUNDARY_GENERALISED of solver/src/contract/blocks.rs.
 const BOUNDARY_GENERALISED: u32 = 1u;
 
 // The pressure of the momentum equation: Tait's, without tension when the case says so.

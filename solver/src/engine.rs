@@ -3,8 +3,8 @@
 //! the same order on the same uniform (`SimParams`) and the same step state (`StepState`), so
 //! time keeping, recovery, the open flume's host side and observations stay in one place.
 
+use crate::contract::{Extremes, SimParams, StepState};
 use crate::error::SolverError;
-use crate::gpu::params::{Extremes, SimParams, StepState};
 
 /// The state as the backend stores it: positions, velocity-density and ids, each in the
 /// backend's own order (the cell order of the last step).
@@ -89,4 +89,25 @@ pub trait Engine: Send {
     fn observe(&self) -> Result<(Vec<[f32; 4]>, Extremes), SolverError>;
     /// Time per stage so far; empty where the backend cannot time its stages apart.
     fn stage_times(&self) -> Vec<StageTime>;
+}
+
+/// Which optional stages a case's pipeline has.
+#[derive(Clone, Copy, Debug)]
+pub struct PipelineShape {
+    pub dim: u32,
+    pub divisions: u32,
+    pub verlet: bool,
+    pub multiphase: bool,
+    pub yield_release: bool,
+}
+
+/// Particles listed in storage order, reordered by id (index i holds the particle of id i).
+pub fn by_id<T: Copy + Default>(values: &[T], ids: &[u32]) -> Vec<T> {
+    let mut out = vec![T::default(); values.len()];
+    for (v, &id) in values.iter().zip(ids) {
+        if let Some(slot) = out.get_mut(id as usize) {
+            *slot = *v;
+        }
+    }
+    out
 }

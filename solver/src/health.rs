@@ -16,7 +16,7 @@
 //! recycle a particle) keeps the 10 % bound as a failure.
 
 use crate::config::Case;
-use crate::gpu::params::ExcludedParticle;
+use crate::contract::ExcludedParticle;
 use crate::particles::{Particles, WALL_PHASE, parked_phase};
 
 /// |rho / rho0 - 1| above which a density is a runaway in a closed tank, and the start-up bound:

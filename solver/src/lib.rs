@@ -47,12 +47,14 @@ mod flume;
 mod health;
 mod load;
 mod observe;
-mod uniform;
 
 // Internals that the solver's tests (`solver/tests/`) reach into: stage specs, uniform
 // layouts, pipeline constants, the recovery policy, phase codes and parking spots, the
 // generator's count, the inlet scan's reference. Hidden from the docs; not for the node.
 
+/// The uniform blocks both engines run on, and their builder from a case.
+#[doc(hidden)]
+pub mod contract;
 #[doc(hidden)]
 pub mod engine;
 #[doc(hidden)]

@@ -2,7 +2,7 @@
 //! the surge front and the state's health figures.
 
 use crate::config::Case;
-use crate::gpu::params::{Extremes, from_order_key};
+use crate::contract::{Extremes, from_order_key};
 use crate::physics::probe::{ProbeSums, free_surface_level};
 
 /// Kernel fullness at which a gauge puts the free surface: half a kernel's worth of fluid,

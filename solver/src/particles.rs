@@ -56,7 +56,7 @@ impl Parking {
 /// it; particles above the grid still live in its top row).
 pub const SPLASH_ROOM: f64 = 0.25;
 
-/// Particle state on the CPU, in the GPU's layout (see `gpu::params`).
+/// Particle state on the CPU, in the GPU's layout (see `contract`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Particles {
     /// x, y, z (z = 0 in 2-D) and, in w, the phase code as f32 bits: read it with `phase`.

@@ -1,7 +1,7 @@
 //! Tier 1, no GPU needed: every stage composes, naga validates it, its declared bindings and
 //! workgroup size match the WGSL, and the Rust mirrors of WGSL structs have naga's layout.
 
-use flume_solver::gpu::params::{
+use flume_solver::contract::{
     ExcludedParticle, Extremes, FlumeGpu, InletQuery, PhaseParams, ScanInfo, SedimentGpu,
     SimParams, StepState,
 };

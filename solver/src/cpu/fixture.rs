@@ -4,7 +4,7 @@
 //! same-phase diffusion, approaching and receding pairs, the bed's nearest water) is taken.
 
 use super::grid::Grid;
-use crate::gpu::params::SimParams;
+use crate::contract::SimParams;
 use crate::physics::sediment::SedimentParams;
 use crate::physics::sediment::pass::SedimentModel;
 use crate::physics::{Params, Phase, Viscosity};

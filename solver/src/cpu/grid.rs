@@ -4,7 +4,7 @@
 //! Sorting inside cells by id makes the order, and with it every neighbour sum, a function of
 //! the state alone: runs are bit-identical whatever came before and on any number of threads.
 
-use crate::gpu::params::SimParams;
+use crate::contract::SimParams;
 use crate::physics::lanes::{LANES, LaneMask};
 use rayon::prelude::*;
 use std::ops::Range;

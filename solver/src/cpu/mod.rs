@@ -18,10 +18,10 @@ mod simd;
 mod step;
 mod store;
 
+use crate::contract::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
 use crate::engine::{Engine, InletScan, RawState, StageTime};
+use crate::engine::{PipelineShape, by_id};
 use crate::error::SolverError;
-use crate::gpu::engine::{PipelineShape, by_id};
-use crate::gpu::params::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
 use crate::particles::Particles;
 use crate::physics;
 use crate::physics::sediment::pass::SedimentModel;

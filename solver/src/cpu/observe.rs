@@ -4,7 +4,7 @@
 
 use super::State;
 use super::grid::Grid;
-use crate::gpu::params::{Extremes, order_key};
+use crate::contract::{Extremes, order_key};
 use crate::physics::Params;
 use crate::physics::interaction::phase_index;
 use crate::physics::probe::{ProbeSums, add_particle};

@@ -9,7 +9,7 @@ use super::grid::Grid;
 use super::multiphase::rheology_pass;
 use super::store::{Event, Store, tally};
 use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
-use crate::gpu::params::{SimParams, StepState};
+use crate::contract::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};

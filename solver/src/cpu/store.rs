@@ -3,7 +3,7 @@
 //! and in an open flume the outlet, the collector, the inlet buffer, a bottom outlet's duct,
 //! the parked reservoir and the exclusion of a particle whose density left the range.
 
-use crate::gpu::params::{BOUNDARY_GENERALISED, ExcludedParticle, FlumeGpu, SimParams};
+use crate::contract::{BOUNDARY_GENERALISED, ExcludedParticle, FlumeGpu, SimParams};
 use crate::health::Health;
 use crate::physics::integrate::Particle;
 use crate::physics::{Params, Phase};
@@ -253,7 +253,7 @@ impl<'a> Store<'a> {
 
 /// Adds a step's events, in sorted order, to the step state's flags and counters; the first
 /// exclusions of the chunk are logged.
-pub fn tally(st: &mut crate::gpu::params::StepState, events: &[Event]) {
+pub fn tally(st: &mut crate::contract::StepState, events: &[Event]) {
     for e in events {
         st.status |= e.flags;
         st.parked += u32::from(e.parked);

@@ -4,23 +4,13 @@
 use super::GpuContext;
 use super::buffers::{cast_vec, read_buffers, storage_init, uniform_init};
 use super::inlet::InletScanner;
-use super::params::{Extremes, SimParams, StepState};
 use super::state::{GpuBuffers, StateBuffers};
-use crate::engine::{Engine, InletScan, RawState, StageTime};
+use crate::contract::{Extremes, SimParams, StepState};
+use crate::engine::{Engine, InletScan, PipelineShape, RawState, StageTime, by_id};
 use crate::error::SolverError;
 use crate::particles::Particles;
 use crate::pipeline::{Bindings, SphPipeline};
 use std::sync::Arc;
-
-/// Which optional stages a case's pipeline has.
-#[derive(Clone, Copy, Debug)]
-pub struct PipelineShape {
-    pub dim: u32,
-    pub divisions: u32,
-    pub verlet: bool,
-    pub multiphase: bool,
-    pub yield_release: bool,
-}
 
 pub struct GpuEngine {
     gpu: Arc<GpuContext>,
@@ -114,17 +104,6 @@ impl GpuEngine {
             .queue
             .write_buffer(&self.buffers.state, 0, bytemuck::bytes_of(state));
     }
-}
-
-/// Particles listed in storage order, reordered by id (index i holds the particle of id i).
-pub fn by_id<T: Copy + Default>(values: &[T], ids: &[u32]) -> Vec<T> {
-    let mut out = vec![T::default(); values.len()];
-    for (v, &id) in values.iter().zip(ids) {
-        if let Some(slot) = out.get_mut(id as usize) {
-            *slot = *v;
-        }
-    }
-    out
 }
 
 impl Engine for GpuEngine {

@@ -3,9 +3,9 @@
 
 use super::GpuContext;
 use super::buffers::{cast_vec, read_buffers, storage, uniform_init};
-use super::params::InletQuery;
 use super::stage::Stage;
 use super::state::GpuBuffers;
+use crate::contract::InletQuery;
 use crate::engine::InletScan;
 use crate::error::SolverError;
 use bytemuck::Zeroable;

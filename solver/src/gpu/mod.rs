@@ -4,7 +4,6 @@ pub mod buffers;
 pub mod context;
 pub mod engine;
 pub mod inlet;
-pub mod params;
 pub mod shader;
 pub mod stage;
 pub mod state;

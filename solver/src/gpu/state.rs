@@ -3,7 +3,7 @@
 use super::GpuContext;
 use super::GpuError;
 use super::buffers::{indirect, particle_texture, storage};
-use super::params::{ScanInfo, StepState};
+use crate::contract::{ScanInfo, StepState};
 use crate::pipeline::TEXEL_ROW_SHIFT;
 use crate::stages::{self, PREFIX_SUM_BLOCK};
 

@@ -11,7 +11,7 @@ impl Simulation {
     /// pass over every other particle by brute force, then its Shields step, both the code the
     /// CPU backend runs. None for a case without a sediment.
     pub fn shields_chains(&self, particles: &Particles) -> Option<Vec<(usize, ShieldsChain)>> {
-        let model = crate::uniform::sediment_model(&self.case, &self.derived)?;
+        let model = crate::contract::sediment_model(&self.case, &self.derived)?;
         let params = self
             .params
             .physics(self.case.dimension, self.derived.phases.len());

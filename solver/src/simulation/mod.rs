@@ -11,18 +11,19 @@ pub use inflow::{InflowSchedule, RefusedInflow};
 
 use crate::backend::Backend;
 use crate::config::{Case, Integrator, Viscosity, YieldCriterion};
+use crate::contract::sim_params;
+use crate::contract::*;
 use crate::derived::{Derived, check_inflow, derive};
 use crate::engine::{Engine, StageTime};
+use crate::engine::{PipelineShape, by_id};
 use crate::error::SolverError;
 use crate::flume::FlumeState;
 use crate::generate::{count, generate};
-use crate::gpu::engine::{GpuEngine, PipelineShape, by_id};
-use crate::gpu::params::*;
+use crate::gpu::engine::GpuEngine;
 use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
 use crate::particles::{Parking, ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
-use crate::uniform::sim_params;
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
@@ -180,7 +181,7 @@ impl Simulation {
                 threads,
                 &params,
                 derived.phases.len(),
-                crate::uniform::sediment_model(case, &derived),
+                crate::contract::sediment_model(case, &derived),
                 &particles,
                 &probes.points,
                 shape,

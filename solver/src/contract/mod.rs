@@ -1,13 +1,18 @@
-//! The uniform block both backends run on (`SimParams`), derived from a case: numerics, phases,
-//! the sediment model and the open flume. The CPU backend reads the same block, and the
-//! sediment model of `physics` that both are tested against comes from the same case here.
+//! The contract both engines run on: the uniform blocks (`SimParams`, `StepState` and the
+//! sediment's and the flume's, in `blocks`, laid out for WGSL) and their builder from a case:
+//! numerics, phases, the sediment model and the open flume. The CPU backend reads the same
+//! blocks as the wgpu one, and the sediment model of `physics` that both are tested against
+//! comes from the same case here.
+
+mod blocks;
+
+pub use blocks::*;
 
 use crate::config::{
     BoundaryMethod, Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion,
 };
 use crate::derived::{self, Derived};
 use crate::flume::inlet_velocity;
-use crate::gpu::params::*;
 use crate::health::{RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
 use crate::particles::{Parking, parked_phase};
 use crate::physics::sediment::SedimentParams;
