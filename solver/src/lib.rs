@@ -2,8 +2,8 @@
 //! the model of the flume digital twin. It knows nothing of ROS, DDS, MCAP or wall-clock time:
 //! it takes a case and gives observations.
 //!
-//! Start at `pipeline.rs`: its step lists every stage; each stage name leads to its WGSL file
-//! in `shaders/stages/`, its spec in `stages.rs` and its CPU oracle in `physics`.
+//! Start at `gpu/pipeline.rs`: its step lists every stage; each stage name leads to its WGSL file
+//! in `shaders/stages/`, its spec in `gpu/stages.rs` and its CPU oracle in `physics`.
 //!
 //! The API is what the crate root re-exports, plus `config` (the case file's types) and
 //! `physics` (the reference model). The other public modules are internals, reachable only so
@@ -64,8 +64,4 @@ pub mod gpu;
 #[doc(hidden)]
 pub mod particles;
 #[doc(hidden)]
-pub mod pipeline;
-#[doc(hidden)]
 pub mod simulation;
-#[doc(hidden)]
-pub mod stages;

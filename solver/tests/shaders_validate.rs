@@ -6,7 +6,7 @@ use flume_solver::contract::{
     SimParams, StepState,
 };
 use flume_solver::gpu::stage::Access;
-use flume_solver::stages::ALL;
+use flume_solver::gpu::stages::ALL;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::mem::offset_of;
 
@@ -129,7 +129,7 @@ fn wgsl_constant(stage: &str, name: &str) -> naga::Literal {
 fn texel_row_shift_is_the_same_in_rust_and_wgsl() {
     assert_eq!(
         wgsl_constant("forces_wcsph", "TEXEL_ROW_SHIFT"),
-        naga::Literal::U32(flume_solver::pipeline::TEXEL_ROW_SHIFT)
+        naga::Literal::U32(flume_solver::gpu::state::TEXEL_ROW_SHIFT)
     );
 }
 

@@ -1,4 +1,4 @@
-//! The native CPU backend: the stages of `pipeline.rs` in the same order on the same uniform,
+//! The native CPU backend: the stages of `gpu/pipeline.rs` in the same order on the same uniform,
 //! written in plain Rust over the particle state in cell order and shared out among threads
 //! with rayon. The formulas are those of `solver::physics` (pair terms, rheology, release,
 //! integrators, probes), called per pair and per particle: the backend adds the loops, not the

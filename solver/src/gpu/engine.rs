@@ -8,8 +8,8 @@ use super::state::{GpuBuffers, StateBuffers};
 use crate::contract::{Extremes, SimParams, StepState};
 use crate::engine::{Engine, InletScan, PipelineShape, RawState, StageTime, by_id};
 use crate::error::SolverError;
+use crate::gpu::pipeline::{Bindings, SphPipeline};
 use crate::particles::Particles;
-use crate::pipeline::{Bindings, SphPipeline};
 use std::sync::Arc;
 
 pub struct GpuEngine {

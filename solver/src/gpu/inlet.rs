@@ -66,7 +66,7 @@ impl Room {
 impl InletScanner {
     pub fn new(gpu: &GpuContext) -> InletScanner {
         InletScanner {
-            stage: Stage::new(&gpu.device, &crate::stages::INLET_SCAN, &[]),
+            stage: Stage::new(&gpu.device, &crate::gpu::stages::INLET_SCAN, &[]),
             room: None,
         }
     }

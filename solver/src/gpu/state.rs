@@ -4,8 +4,11 @@ use super::GpuContext;
 use super::GpuError;
 use super::buffers::{indirect, particle_texture, storage};
 use crate::contract::{ScanInfo, StepState};
-use crate::pipeline::TEXEL_ROW_SHIFT;
-use crate::stages::{self, PREFIX_SUM_BLOCK};
+use crate::gpu::stages::{self, PREFIX_SUM_BLOCK};
+
+/// Rows of the particle textures are 2^TEXEL_ROW_SHIFT texels wide; mirrors the WGSL constant
+/// of the same name in `shaders/common/particle_texture.wgsl` (checked by `shaders_validate`).
+pub const TEXEL_ROW_SHIFT: u32 = 11;
 
 /// Particle state and scratch, all resident on the GPU. `a` is the state between steps,
 /// `b` its copy in cell order at the start of a step, `c` the half-step state; `b` and `c`
@@ -147,7 +150,7 @@ impl GpuBuffers {
             cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),
             cell_cursor: storage(gpu, "cell_cursor", u64::from(n_cells + 1) * 4),
             sorted_index: storage(gpu, "sorted_index", n * 4),
-            dispatch: indirect(gpu, "active dispatch", crate::pipeline::DISPATCH_BYTES),
+            dispatch: indirect(gpu, "active dispatch", crate::gpu::pipeline::DISPATCH_BYTES),
             scan_levels,
             state: storage(gpu, "step state", std::mem::size_of::<StepState>() as u64),
             probe_points: storage(gpu, "probe points", u64::from(n_probes.max(1)) * VEC4_BYTES),

@@ -65,7 +65,7 @@ pub struct Simulation {
 }
 
 fn divisions_of(case: &Case, h: f64) -> u32 {
-    crate::pipeline::cell_divisions(case.dimension, h / case.numerics.dp_m)
+    crate::gpu::pipeline::cell_divisions(case.dimension, h / case.numerics.dp_m)
 }
 
 /// Grid of cells of size 2h / cell_divisions covering the tank, its walls and a margin above it.

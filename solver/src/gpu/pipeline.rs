@@ -10,8 +10,8 @@
 
 use crate::gpu::GpuContext;
 use crate::gpu::stage::{Stage, groups};
+use crate::gpu::stages::{self, PREFIX_SUM_BLOCK};
 use crate::gpu::state::GpuBuffers;
-use crate::stages::{self, PREFIX_SUM_BLOCK};
 
 /// Workgroup sizes `active_dispatch` counts the active particles in: the neighbour passes'
 /// and the per-particle passes' (the integrators, `parked_copy`, `observe_reduce`).
@@ -147,10 +147,6 @@ impl SphPipeline {
         }
     }
 }
-
-/// Rows of the particle textures are 2^TEXEL_ROW_SHIFT texels wide; mirrors the WGSL constant
-/// of the same name in `shaders/common/particle_texture.wgsl` (checked by `shaders_validate`).
-pub const TEXEL_ROW_SHIFT: u32 = 11;
 
 pub struct Bindings {
     grid_clear: wgpu::BindGroup,
