@@ -134,6 +134,39 @@ mod tests {
         }
     }
 
+    /// The bundled session with one bit flipped three quarters into the lz4 records of its
+    /// middle chunk (where the replay test flips it). The flip decompresses into a record
+    /// length of 249 GB: a reader that trusted it before the chunk's CRC aborted the process
+    /// allocating it. Read, it is a damage after the whole chunks before it.
+    #[test]
+    fn a_flipped_bit_that_decompresses_into_a_huge_record_is_damage() {
+        let session = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tests/data/ulbra_session.mcap"
+        );
+        let mut bytes = std::fs::read(session).expect("the bundled session");
+        let whole = BagFile::read(std::path::Path::new(session)).expect("reads");
+        assert_eq!(whole.damage, None);
+        let (mut chunks, mut at) = (Vec::new(), 8);
+        while at + 9 <= bytes.len() {
+            let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().expect("8 bytes"));
+            if bytes[at] == 0x06 {
+                chunks.push((at + 9, len as usize));
+            }
+            at += 9 + len as usize;
+        }
+        let (body, len) = chunks[chunks.len() / 2];
+        bytes[body + len - len / 4] ^= 0x04;
+        let bad = temp("huge.mcap");
+        std::fs::write(&bad, &bytes).expect("writes");
+        let r = BagFile::read(&bad).expect("a damaged file is no error");
+        let damage = r.damage.expect("the flip is reported");
+        assert!(damage.contains("is damaged: read"), "{damage}");
+        let n = r.messages.len();
+        assert!(n > 0 && n < whole.messages.len(), "{n} messages");
+        std::fs::remove_file(bad).ok();
+    }
+
     /// A bag directory's metadata.yaml as YAML.
     fn metadata(dir: &std::path::Path) -> serde_norway::Value {
         let text = std::fs::read_to_string(dir.join("metadata.yaml")).expect("metadata.yaml");

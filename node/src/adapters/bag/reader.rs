@@ -3,8 +3,11 @@
 
 use crate::adapters::bag::directory::recordings_in;
 use anyhow::{Context, Result, bail};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use serde::de::DeserializeOwned;
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// One message as recorded: its topic, its type's schema name and its CDR bytes.
 #[derive(Debug, Clone)]
@@ -71,56 +74,98 @@ impl BagFile {
                 path.display()
             );
         }
-        let options = mcap::read::Options::IgnoreEndMagic | mcap::read::Options::ValidateChunkCrcs;
-        let stream = mcap::MessageStream::new_with_options(&bytes, options)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let mut messages = Vec::new();
-        let mut damage = None;
-        let mut definitions: Vec<(u16, std::sync::Arc<[u8]>)> = Vec::new();
-        for item in stream {
-            match item {
-                Ok(m) => {
-                    let (schema_name, definition) = match &m.channel.schema {
-                        Some(s) => {
-                            let def = match definitions.iter().find(|(id, _)| *id == s.id) {
-                                Some((_, d)) => d.clone(),
-                                None => {
-                                    let d: std::sync::Arc<[u8]> = s.data.as_ref().into();
-                                    definitions.push((s.id, d.clone()));
-                                    d
-                                }
-                            };
-                            (s.name.clone(), def)
-                        }
-                        None => (String::new(), std::sync::Arc::from(&[][..])),
-                    };
-                    messages.push(BagMessage {
-                        topic: m.channel.topic.clone(),
+        let mut records = Records::default();
+        let damage = records.read(&bytes).err().map(|e| {
+            let last = records.messages.last().map_or(String::new(), |m| {
+                format!(" (the last logged at {} ns)", m.log_ns)
+            });
+            format!(
+                "{} is damaged: read {} messages{last}, then: {e}",
+                path.display(),
+                records.messages.len()
+            )
+        });
+        Ok(BagFile {
+            messages: records.messages,
+            damage,
+        })
+    }
+}
+
+/// The schemas, channels and messages of one file, as its records are read.
+#[derive(Default)]
+struct Records {
+    /// Schema id: its name and definition.
+    schemas: HashMap<u16, (String, Arc<[u8]>)>,
+    channels: HashMap<u16, mcap::records::Channel>,
+    messages: Vec<BagMessage>,
+}
+
+impl Records {
+    /// Reads `bytes` up to the data section's end, or to the first damage, which it returns.
+    /// Each chunk's CRC is checked before any of its records is used, and no record may claim
+    /// more bytes than the file has: a flipped bit in a chunk's compressed records once
+    /// decompressed into a record length of 249 GB, and the reader that trusted it aborted.
+    fn read(&mut self, bytes: &[u8]) -> Result<(), mcap::McapError> {
+        let options = LinearReaderOptions::default()
+            .with_skip_end_magic(true)
+            .with_validate_chunk_crcs(true)
+            .with_prevalidate_chunk_crcs(true)
+            .with_record_length_limit(bytes.len());
+        let mut reader = LinearReader::new_with_options(options);
+        let mut rest = bytes;
+        while let Some(event) = reader.next_event() {
+            let wanted = match event? {
+                LinearReadEvent::ReadRequest(n) => n.min(rest.len()),
+                LinearReadEvent::Record { data, opcode } => {
+                    if !self.add(mcap::parse_record(opcode, data)?) {
+                        return Ok(());
+                    }
+                    continue;
+                }
+            };
+            reader.insert(wanted).copy_from_slice(&rest[..wanted]);
+            reader.notify_read(wanted);
+            rest = &rest[wanted..];
+        }
+        Ok(())
+    }
+
+    /// Takes one record; false at the data section's end.
+    fn add(&mut self, record: mcap::records::Record<'_>) -> bool {
+        use mcap::records::Record;
+        match record {
+            Record::Schema { header, data } => {
+                self.schemas
+                    .entry(header.id)
+                    .or_insert_with(|| (header.name, data.as_ref().into()));
+            }
+            Record::Channel(channel) => {
+                self.channels.insert(channel.id, channel);
+            }
+            Record::Message { header, data } => {
+                // A message on a channel never declared is a malformed file: it is skipped,
+                // as no topic can be given to it.
+                if let Some(channel) = self.channels.get(&header.channel_id) {
+                    let (schema_name, definition) = self
+                        .schemas
+                        .get(&channel.schema_id)
+                        .cloned()
+                        .unwrap_or_else(|| (String::new(), Arc::from(&[][..])));
+                    self.messages.push(BagMessage {
+                        topic: channel.topic.clone(),
                         schema_name,
                         definition,
-                        offered_qos_profiles: m
-                            .channel
-                            .metadata
-                            .get("offered_qos_profiles")
-                            .cloned(),
-                        log_ns: m.log_time,
-                        publish_ns: m.publish_time,
-                        data: m.data.into_owned(),
+                        offered_qos_profiles: channel.metadata.get("offered_qos_profiles").cloned(),
+                        log_ns: header.log_time,
+                        publish_ns: header.publish_time,
+                        data: data.into_owned(),
                     });
-                }
-                Err(e) => {
-                    let last = messages.last().map_or(String::new(), |m: &BagMessage| {
-                        format!(" (the last logged at {} ns)", m.log_ns)
-                    });
-                    damage = Some(format!(
-                        "{} is damaged: read {} messages{last}, then: {e}",
-                        path.display(),
-                        messages.len()
-                    ));
-                    break;
                 }
             }
+            Record::DataEnd(_) => return false,
+            _ => {}
         }
-        Ok(BagFile { messages, damage })
+        true
     }
 }
