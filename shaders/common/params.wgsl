@@ -1,5 +1,5 @@
-// Simulation parameters shared by every stage; mirrored by `SimParams` in solver/src/contract/blocks.rs
-// (a test checks the two layouts agree). Lengths in m, times in s, densities in kg/m3.
+// Simulation parameters shared by every stage, laid out as `SimParams` of
+// solver/src/contract/blocks.rs (solver/tests/shaders_validate.rs checks the two layouts agree). Lengths in m, times in s, densities in kg/m3.
 
 struct Phase {
     rho0: f32,      // rest density of the Tait equation

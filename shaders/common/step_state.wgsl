@@ -14,7 +14,7 @@ struct ExcludedParticle {
     pad: u32,
 }
 
-// Mirrors `EXCLUDED_LOG_LEN` in solver/src/contract/blocks.rs.
+// `EXCLUDED_LOG_LEN` of solver/src/contract/blocks.rs (checked by solver/tests/shaders_validate.rs).
 const EXCLUDED_LOG_LEN: u32 = 8u;
 
 struct StepState {

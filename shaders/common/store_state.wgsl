@@ -1,7 +1,7 @@
 // The end of an integration step, shared by both integrators: the importing stage declares
 // `state`, `regions`, `positions_out` and `vel_rho_out`.
 
-// Mirrors REGION_HELD of shaders/common/sediment.wgsl.
+// REGION_HELD of shaders/common/sediment.wgsl (checked by solver/tests/shaders_validate.rs).
 const REGION_HELD_BIT: u32 = 256u;
 
 // Whether the rheology pass held the particle of this id fixed (`regions` is by id).

@@ -16,8 +16,8 @@
 @group(0) @binding(6) var stress_a: texture_2d<f32>;
 @group(0) @binding(7) var stress_b: texture_2d<f32>;
 
+// The modes of solver/src/contract/blocks.rs (checked by solver/tests/shaders_validate.rs).
 const VISCOSITY_MULTIPHASE: u32 = 2u;
-// Mirrors BOUNDARY_GENERALISED of solver/src/contract/blocks.rs.
 const BOUNDARY_GENERALISED: u32 = 1u;
 
 // The pressure of the momentum equation: Tait's, without tension when the case says so.

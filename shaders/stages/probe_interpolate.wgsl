@@ -13,7 +13,7 @@
 @group(0) @binding(6) var<storage, read> ids: array<u32>;
 @group(0) @binding(7) var<storage, read> regions: array<u32>;
 
-// Mirrors REGION_UNYIELDED of shaders/common/sediment.wgsl.
+// REGION_UNYIELDED of shaders/common/sediment.wgsl, as a word (checked by solver/tests/shaders_validate.rs).
 const REGION_UNYIELDED_WORD: u32 = 1u;
 
 @compute @workgroup_size(64)

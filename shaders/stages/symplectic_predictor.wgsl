@@ -15,7 +15,7 @@
 @group(0) @binding(8) var<storage, read> ids_n: array<u32>;
 @group(0) @binding(9) var<storage, read> cell_starts: array<u32>;
 
-// Mirrors REGION_HELD of shaders/common/sediment.wgsl.
+// REGION_HELD of shaders/common/sediment.wgsl (checked by solver/tests/shaders_validate.rs).
 const REGION_HELD_BIT: u32 = 256u;
 
 @compute @workgroup_size(128)

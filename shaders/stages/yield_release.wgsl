@@ -15,7 +15,7 @@
 @group(0) @binding(7) var<storage, read_write> regions: array<u32>;
 @group(0) @binding(8) var<storage, read> ids: array<u32>;
 
-// Mirrors FLOW_ONSET of solver/src/physics/sediment/hold.rs.
+// FLOW_ONSET of solver/src/physics/sediment/hold.rs (checked by solver/tests/shaders_validate.rs).
 const FLOW_ONSET: f32 = 2.0;
 
 // As the rheology pass it follows.

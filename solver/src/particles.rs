@@ -118,7 +118,7 @@ impl ParticleRegion {
     }
 }
 
-/// The bits of a region word that hold the region (mirrors `& 255u` in the shaders).
+/// The bits of a region word that hold the region (`& 255u` in the shaders).
 const REGION_MASK: u32 = 0xff;
 
 #[cfg(test)]

@@ -125,20 +125,101 @@ fn wgsl_constant(stage: &str, name: &str) -> naga::Literal {
     }
 }
 
+/// Every constant that the WGSL and the Rust each state, by value, from the composed module of
+/// a stage that uses it: one side changed alone fails here. (`HUGE`, WGSL's stand-in for an
+/// infinite viscosity, has no Rust twin.)
 #[test]
-fn texel_row_shift_is_the_same_in_rust_and_wgsl() {
-    assert_eq!(
-        wgsl_constant("forces_wcsph", "TEXEL_ROW_SHIFT"),
-        naga::Literal::U32(flume_solver::gpu::state::TEXEL_ROW_SHIFT)
-    );
-}
-
-#[test]
-fn flow_onset_is_the_same_in_rust_and_wgsl() {
-    assert_eq!(
-        wgsl_constant("yield_release", "FLOW_ONSET"),
-        naga::Literal::F32(flume_solver::physics::sediment::hold::FLOW_ONSET)
-    );
+fn every_constant_stated_on_both_sides_agrees() {
+    use flume_solver::contract as c;
+    use flume_solver::physics::sediment::{hold, pass, rheology, shields, suspension};
+    use flume_solver::{Health, Region};
+    use naga::Literal::{F32, U32};
+    let region = |r: Region| U32(r as u32);
+    let checks = [
+        (
+            "forces_wcsph",
+            "TEXEL_ROW_SHIFT",
+            U32(flume_solver::gpu::state::TEXEL_ROW_SHIFT),
+        ),
+        (
+            "forces_wcsph",
+            "VISCOSITY_MULTIPHASE",
+            U32(c::VISCOSITY_MULTIPHASE),
+        ),
+        (
+            "forces_wcsph",
+            "BOUNDARY_GENERALISED",
+            U32(c::BOUNDARY_GENERALISED),
+        ),
+        (
+            "prefix_sum",
+            "BLOCK",
+            U32(flume_solver::gpu::stages::PREFIX_SUM_BLOCK),
+        ),
+        (
+            "dt_update",
+            "EXCLUDED_LOG_LEN",
+            U32(c::EXCLUDED_LOG_LEN as u32),
+        ),
+        ("dt_update", "STATUS_NON_FINITE", U32(Health::NON_FINITE)),
+        (
+            "dt_update",
+            "STATUS_DENSITY_RUNAWAY",
+            U32(Health::DENSITY_RUNAWAY),
+        ),
+        ("dt_update", "STATUS_DT_COLLAPSE", U32(Health::DT_COLLAPSE)),
+        ("yield_release", "FLOW_ONSET", F32(hold::FLOW_ONSET)),
+        ("rheology", "KARMAN", F32(shields::KARMAN)),
+        (
+            "rheology",
+            "SUBLAYER_WALL_UNITS",
+            F32(shields::SUBLAYER_WALL_UNITS),
+        ),
+        ("rheology", "SMOOTH_RE_K", F32(shields::SMOOTH_RE_K)),
+        ("rheology", "ROUGH_RE_K", F32(shields::ROUGH_RE_K)),
+        ("rheology", "Z0_SMOOTH", F32(shields::Z0_SMOOTH)),
+        ("rheology", "Z0_ROUGH", F32(shields::Z0_ROUGH)),
+        (
+            "rheology",
+            "BISECTION_REL_TOL",
+            F32(shields::BISECTION_REL_TOL),
+        ),
+        (
+            "rheology",
+            "FRICTION_VELOCITY_MAX_ITERATIONS",
+            U32(shields::FRICTION_VELOCITY_MAX_ITERATIONS),
+        ),
+        (
+            "rheology",
+            "PAPANASTASIOU_SERIES_LIMIT",
+            F32(rheology::PAPANASTASIOU_SERIES_LIMIT),
+        ),
+        (
+            "rheology",
+            "SUSPENSION_CONCENTRATION",
+            F32(suspension::SUSPENSION_CONCENTRATION),
+        ),
+        ("rheology", "REGION_UNYIELDED", region(Region::Unyielded)),
+        ("rheology", "REGION_YIELDED", region(Region::Yielded)),
+        ("rheology", "REGION_BED_LOAD", region(Region::BedLoad)),
+        ("rheology", "REGION_SUSPENDED", region(Region::Suspended)),
+        ("rheology", "REGION_WATER", region(Region::Water)),
+        ("rheology", "REGION_HELD", U32(pass::REGION_HELD)),
+        (
+            "symplectic_predictor",
+            "REGION_HELD_BIT",
+            U32(pass::REGION_HELD),
+        ),
+        ("verlet_update", "REGION_HELD_BIT", U32(pass::REGION_HELD)),
+        (
+            "probe_interpolate",
+            "REGION_UNYIELDED_WORD",
+            region(Region::Unyielded),
+        ),
+    ];
+    for (stage, name, rust) in checks {
+        assert_eq!(wgsl_constant(stage, name), rust, "{name} in {stage}");
+    }
 }
 
 /// Offsets and size of a named WGSL struct as naga lays it out.

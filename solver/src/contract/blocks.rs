@@ -1,5 +1,6 @@
-//! `SimParams`, the uniform every stage reads; mirrors `shaders/common/params.wgsl`
-//! (`shaders_validate` checks the offsets against naga's layout of the WGSL struct).
+//! `SimParams`, the uniform every stage reads, and the other blocks, each laid out as its WGSL
+//! struct (`shaders_validate` checks the offsets against naga's layout of the WGSL, and every
+//! constant stated on both sides by value).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -15,7 +16,7 @@ pub struct PhaseParams {
     pub mobile: f32,
 }
 
-/// Mirrors `Sediment` in `shaders/common/params.wgsl` (units there).
+/// `Sediment` of `shaders/common/params.wgsl` (units there).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct SedimentGpu {
@@ -41,7 +42,7 @@ pub struct SedimentGpu {
     pub pad1: f32,
 }
 
-/// Mirrors `Flume` in `shaders/common/params.wgsl` (units there).
+/// `Flume` of `shaders/common/params.wgsl` (units there).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct FlumeGpu {
@@ -109,10 +110,10 @@ pub const DIFFUSION_NONE: u32 = 0;
 pub const DIFFUSION_MOLTENI: u32 = 1;
 pub const DIFFUSION_FOURTAKAS: u32 = 2;
 
-/// Entries of `StepState::excluded_log`; mirrors `EXCLUDED_LOG_LEN` in step_state.wgsl.
+/// Entries of `StepState::excluded_log` (`EXCLUDED_LOG_LEN` of step_state.wgsl too).
 pub const EXCLUDED_LOG_LEN: usize = 8;
 
-/// Mirrors `ExcludedParticle` in `shaders/common/step_state.wgsl`.
+/// `ExcludedParticle` of `shaders/common/step_state.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct ExcludedParticle {
@@ -126,7 +127,7 @@ pub struct ExcludedParticle {
     pub pad: u32,
 }
 
-/// Mirrors `StepState` in `shaders/common/step_state.wgsl`.
+/// `StepState` of `shaders/common/step_state.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct StepState {
@@ -174,7 +175,7 @@ impl StepState {
     }
 }
 
-/// Mirrors `Extremes` in `shaders/stages/observe_reduce.wgsl`.
+/// `Extremes` of `shaders/stages/observe_reduce.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct Extremes {
@@ -193,7 +194,7 @@ pub fn from_order_key(k: u32) -> f32 {
     }
 }
 
-/// Mirrors `ScanInfo` in `shaders/stages/prefix_sum.wgsl`.
+/// `ScanInfo` of `shaders/stages/prefix_sum.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct ScanInfo {
@@ -201,7 +202,7 @@ pub struct ScanInfo {
     pub pad: [u32; 3],
 }
 
-/// Mirrors `InletQuery` in `shaders/stages/inlet_scan.wgsl`: the inlet's spots to check and
+/// `InletQuery` of `shaders/stages/inlet_scan.wgsl`: the inlet's spots to check and
 /// the square of the distance within which a particle occupies one, m2.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -211,8 +212,8 @@ pub struct InletQuery {
     pub pad: [u32; 2],
 }
 
-/// Maps f32 to u32 so that unsigned order is float order (negative values too); mirrors the
-/// shader's `order_key` in observe_reduce.wgsl.
+/// Maps f32 to u32 so that unsigned order is float order (negative values too), as the
+/// shader's `order_key` in observe_reduce.wgsl does.
 pub fn order_key(x: f32) -> u32 {
     let b = x.to_bits();
     if b & 0x8000_0000 != 0 {

@@ -6,8 +6,8 @@ use super::buffers::{indirect, particle_texture, storage};
 use crate::contract::{ScanInfo, StepState};
 use crate::gpu::stages::{self, PREFIX_SUM_BLOCK};
 
-/// Rows of the particle textures are 2^TEXEL_ROW_SHIFT texels wide; mirrors the WGSL constant
-/// of the same name in `shaders/common/particle_texture.wgsl` (checked by `shaders_validate`).
+/// Rows of the particle textures are 2^TEXEL_ROW_SHIFT texels wide, as the WGSL constant of
+/// the same name in `shaders/common/particle_texture.wgsl` (checked by `shaders_validate`).
 pub const TEXEL_ROW_SHIFT: u32 = 11;
 
 /// Particle state and scratch, all resident on the GPU. `a` is the state between steps,

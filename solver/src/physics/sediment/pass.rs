@@ -59,8 +59,8 @@ pub struct ParticleRheology {
     pub held: bool,
 }
 
-/// Bit of a region word marking sediment held fixed; mirrors `REGION_HELD` of
-/// `shaders/common/sediment.wgsl`.
+/// Bit of a region word marking sediment held fixed; `REGION_HELD` of
+/// `shaders/common/sediment.wgsl` too (checked by `shaders_validate`).
 pub const REGION_HELD: u32 = 256;
 
 impl ParticleRheology {

@@ -42,11 +42,11 @@ pub const FRICTION_VELOCITY_MAX_ITERATIONS: u32 = 64;
 pub const CRITICAL_SHIELDS_MAX_ITERATIONS: u32 = 100;
 
 /// z0 coefficient of the smooth regime (`0.11 nu / u*`) and of the rough one (`0.033 ks`).
-const Z0_SMOOTH: f32 = 0.11;
-const Z0_ROUGH: f32 = 0.033;
+pub const Z0_SMOOTH: f32 = 0.11;
+pub const Z0_ROUGH: f32 = 0.033;
 /// The search stops when the bracket is within this relative width: four f32 ulps, below which
 /// rounding of the profile itself decides the comparisons.
-const BISECTION_REL_TOL: f32 = 4.0 * f32::EPSILON;
+pub const BISECTION_REL_TOL: f32 = 4.0 * f32::EPSILON;
 
 /// Critical Shields parameter of Eq. 17 (van Rijn 1993), dimensionless.
 ///
