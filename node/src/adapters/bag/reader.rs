@@ -92,6 +92,12 @@ impl BagFile {
     }
 }
 
+/// The longest record, or decompressed chunk, a recording may hold. The recorder closes a
+/// chunk every second, a few hundred kB of the twin's topics; the file's own length is no
+/// bound, since a chunk decompresses to more than it takes (a killed recording of 40 kB held a
+/// chunk of 61 kB).
+const RECORD_LIMIT_BYTES: usize = 1 << 30;
+
 /// The schemas, channels and messages of one file, as its records are read.
 #[derive(Default)]
 struct Records {
@@ -103,15 +109,16 @@ struct Records {
 
 impl Records {
     /// Reads `bytes` up to the data section's end, or to the first damage, which it returns.
-    /// Each chunk's CRC is checked before any of its records is used, and no record may claim
-    /// more bytes than the file has: a flipped bit in a chunk's compressed records once
-    /// decompressed into a record length of 249 GB, and the reader that trusted it aborted.
+    /// Each chunk's CRC is checked before any of its records is used, and no record or
+    /// decompressed chunk may claim more than [`RECORD_LIMIT_BYTES`]: a flipped bit in a
+    /// chunk's compressed records once decompressed into a record length of 249 GB, and the
+    /// reader that trusted it aborted.
     fn read(&mut self, bytes: &[u8]) -> Result<(), mcap::McapError> {
         let options = LinearReaderOptions::default()
             .with_skip_end_magic(true)
             .with_validate_chunk_crcs(true)
             .with_prevalidate_chunk_crcs(true)
-            .with_record_length_limit(bytes.len());
+            .with_record_length_limit(RECORD_LIMIT_BYTES);
         let mut reader = LinearReader::new_with_options(options);
         let mut rest = bytes;
         while let Some(event) = reader.next_event() {
