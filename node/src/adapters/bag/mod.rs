@@ -167,6 +167,64 @@ mod tests {
         std::fs::remove_file(bad).ok();
     }
 
+    /// An MCAP string: its length as a u32, then its bytes.
+    fn mcap_string(s: &str) -> Vec<u8> {
+        [&(s.len() as u32).to_le_bytes()[..], s.as_bytes()].concat()
+    }
+
+    /// An MCAP file's records by hand (uncompressed, no chunks): the magic, a header, then
+    /// `records` as (opcode, body), then the data end.
+    fn raw_mcap(records: &[(u8, Vec<u8>)]) -> Vec<u8> {
+        let mut out = mcap::MAGIC.to_vec();
+        let header = [mcap_string("ros2"), mcap_string("hand")].concat();
+        for (op, body) in [(0x01, header)]
+            .into_iter()
+            .chain(records.iter().cloned())
+            .chain([(0x0f, 0u32.to_le_bytes().to_vec())])
+        {
+            out.push(op);
+            out.extend((body.len() as u64).to_le_bytes());
+            out.extend(body);
+        }
+        out
+    }
+
+    /// A channel on a schema never declared, and a message on a channel never declared, are
+    /// damage after what comes before them, as mcap's own reader has them, not skipped.
+    #[test]
+    fn records_that_name_what_was_never_declared_are_damage() {
+        let channel = |id: u16, schema: u16| {
+            let ids = [id.to_le_bytes(), schema.to_le_bytes()].concat();
+            let names = [mcap_string("/gauges/p1"), mcap_string("cdr")].concat();
+            (0x04, [ids, names, 0u32.to_le_bytes().to_vec()].concat())
+        };
+        let message = |channel: u16, seq: u32| {
+            let head = [&channel.to_le_bytes()[..], &seq.to_le_bytes()].concat();
+            let times = [1u64.to_le_bytes(), 1u64.to_le_bytes()].concat();
+            (0x05, [head, times, vec![0, 1, 0, 0]].concat())
+        };
+        let cases = [
+            (
+                vec![channel(1, 0), message(1, 0), message(7, 1)],
+                1,
+                "unknown channel 7",
+            ),
+            (vec![channel(1, 9), message(1, 0)], 0, "unknown schema 9"),
+            (vec![channel(1, 0), message(1, 0), message(1, 1)], 2, ""),
+        ];
+        for (k, (records, read, why)) in cases.into_iter().enumerate() {
+            let path = temp(&format!("raw{k}.mcap"));
+            std::fs::write(&path, raw_mcap(&records)).expect("writes");
+            let r = BagFile::read(&path).expect("an MCAP file");
+            assert_eq!(r.messages.len(), read, "case {k}");
+            match r.damage {
+                Some(d) => assert!(!why.is_empty() && d.contains(why), "case {k}: {d}"),
+                None => assert!(why.is_empty(), "case {k}: no damage reported"),
+            }
+            std::fs::remove_file(path).ok();
+        }
+    }
+
     /// A bag directory's metadata.yaml as YAML.
     fn metadata(dir: &std::path::Path) -> serde_norway::Value {
         let text = std::fs::read_to_string(dir.join("metadata.yaml")).expect("metadata.yaml");

@@ -94,8 +94,8 @@ impl BagFile {
 
 /// The longest record, or decompressed chunk, a recording may hold. The recorder closes a
 /// chunk every second, a few hundred kB of the twin's topics; the file's own length is no
-/// bound, since a chunk decompresses to more than it takes (a killed recording of 40 kB held a
-/// chunk of 61 kB).
+/// bound, since a chunk decompresses to more than it takes (a recording killed part way held a
+/// chunk that decompresses to 61 kB, more than the whole file).
 const RECORD_LIMIT_BYTES: usize = 1 << 30;
 
 /// The schemas, channels and messages of one file, as its records are read.
@@ -125,7 +125,7 @@ impl Records {
             let wanted = match event? {
                 LinearReadEvent::ReadRequest(n) => n.min(rest.len()),
                 LinearReadEvent::Record { data, opcode } => {
-                    if !self.add(mcap::parse_record(opcode, data)?) {
+                    if !self.add(mcap::parse_record(opcode, data)?)? {
                         return Ok(());
                     }
                     continue;
@@ -138,8 +138,11 @@ impl Records {
         Ok(())
     }
 
-    /// Takes one record; false at the data section's end.
-    fn add(&mut self, record: mcap::records::Record<'_>) -> bool {
+    /// Takes one record; false at the data section's end. A channel whose schema was never
+    /// declared, or a message on a channel never declared, is damage, as mcap's own reader
+    /// has it: neither can be given a type or a topic.
+    fn add(&mut self, record: mcap::records::Record<'_>) -> Result<bool, mcap::McapError> {
+        use mcap::McapError;
         use mcap::records::Record;
         match record {
             Record::Schema { header, data } => {
@@ -148,31 +151,37 @@ impl Records {
                     .or_insert_with(|| (header.name, data.as_ref().into()));
             }
             Record::Channel(channel) => {
+                // Schema 0 is "no schema".
+                if channel.schema_id != 0 && !self.schemas.contains_key(&channel.schema_id) {
+                    return Err(McapError::UnknownSchema(channel.topic, channel.schema_id));
+                }
                 self.channels.insert(channel.id, channel);
             }
             Record::Message { header, data } => {
-                // A message on a channel never declared is a malformed file: it is skipped,
-                // as no topic can be given to it.
-                if let Some(channel) = self.channels.get(&header.channel_id) {
-                    let (schema_name, definition) = self
-                        .schemas
-                        .get(&channel.schema_id)
-                        .cloned()
-                        .unwrap_or_else(|| (String::new(), Arc::from(&[][..])));
-                    self.messages.push(BagMessage {
-                        topic: channel.topic.clone(),
-                        schema_name,
-                        definition,
-                        offered_qos_profiles: channel.metadata.get("offered_qos_profiles").cloned(),
-                        log_ns: header.log_time,
-                        publish_ns: header.publish_time,
-                        data: data.into_owned(),
-                    });
-                }
+                let Some(channel) = self.channels.get(&header.channel_id) else {
+                    return Err(McapError::UnknownChannel(
+                        header.sequence,
+                        header.channel_id,
+                    ));
+                };
+                let (schema_name, definition) = self
+                    .schemas
+                    .get(&channel.schema_id)
+                    .cloned()
+                    .unwrap_or_else(|| (String::new(), Arc::from(&[][..])));
+                self.messages.push(BagMessage {
+                    topic: channel.topic.clone(),
+                    schema_name,
+                    definition,
+                    offered_qos_profiles: channel.metadata.get("offered_qos_profiles").cloned(),
+                    log_ns: header.log_time,
+                    publish_ns: header.publish_time,
+                    data: data.into_owned(),
+                });
             }
-            Record::DataEnd(_) => return false,
+            Record::DataEnd(_) => return Ok(false),
             _ => {}
         }
-        true
+        Ok(true)
     }
 }
