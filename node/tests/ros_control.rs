@@ -49,15 +49,37 @@ where
     Req: ros2_client::Message + 'static,
     Resp: ros2_client::Message + 'static,
 {
-    // The twin compiles its shaders first: on a busy software adapter that can take a while.
-    tokio::time::timeout(Duration::from_secs(120), client.wait_for_service(node))
-        .await
-        .expect("the twin's parameter service appears");
+    served(node, client).await;
     let id = client.async_send_request(request).await.expect("sent");
     tokio::time::timeout(Duration::from_secs(10), client.async_receive_response(id))
         .await
         .expect("answered in time")
         .expect("an answer")
+}
+
+/// Waits until `client`'s request and reply topics are both matched with the twin's service,
+/// within two minutes (the twin compiles its shaders first: on a busy software adapter that can
+/// take a while). ros2-client 0.12's `wait_for_service` future can miss the match it waits
+/// for: it wakes only on a graph event, and its spinner drops events when the future's 8-event
+/// channel is full, as it likely is while this side's dozen endpoints match at once. Seen here in one
+/// run of five to ten (the future still waiting after 60 s while a fresh one resolved at once,
+/// the endpoints long matched). A fresh future reads the match state when it is made, so
+/// each second starts a new one.
+async fn served<Req, Resp>(node: &Node, client: &ros2_client::service::Client<Req, Resp>)
+where
+    Req: ros2_client::Message + 'static,
+    Resp: ros2_client::Message + 'static,
+{
+    let deadline = tokio::time::Instant::now() + Duration::from_secs(120);
+    while tokio::time::timeout(Duration::from_secs(1), client.wait_for_service(node))
+        .await
+        .is_err()
+    {
+        assert!(
+            tokio::time::Instant::now() < deadline,
+            "the twin's service was not matched within two minutes"
+        );
+    }
 }
 
 fn trigger(
@@ -102,30 +124,10 @@ where
     .flatten()
 }
 
-/// The twin's services were not matched by this side's participant within a minute.
-struct Unmatched;
-
-/// RustDDS on loopback has, rarely, never matched the twin's services with this side's
-/// participant: the wait timed out after two minutes (twice on a loaded machine, once in a
-/// whole suite on an idle one) where a run takes 7 s, and the same test then passed alone
-/// every time. What this test checks is
-/// the services, not discovery, so it starts again once with a new twin and a new
-/// participant, and says so; a second miss fails.
 #[test]
 fn parameters_and_services_from_another_process_control_the_twin() {
     let Some(_gpu) = gpu() else { return };
-    if control_the_twin().is_err() {
-        eprintln!(
-            "the twin's services were never matched (RustDDS discovery): starting again with a new twin and a new participant"
-        );
-        assert!(
-            control_the_twin().is_ok(),
-            "the twin's services were never matched, twice"
-        );
-    }
-}
 
-fn control_the_twin() -> Result<(), Unmatched> {
     let mut twin = KillOnDrop(
         recycle_twin()
             .args([
@@ -147,7 +149,8 @@ fn control_the_twin() -> Result<(), Unmatched> {
             .expect("the twin starts"),
     );
     // This side's DDS participant starts after the twin's: when it came first, on a loaded
-    // machine the twin's parameter services were at times never matched (RustDDS discovery).
+    // machine the wait for the twin's services at times never ended (likely the missed wake
+    // that `served` works around, seen before it was understood).
     // The twin prints `node:` just before it starts DDS; the rest of its output is drained.
     let _drained = read_until(twin.0.stdout.take().expect("stdout"), "node:");
     std::thread::sleep(Duration::from_secs(2));
@@ -227,9 +230,6 @@ fn control_the_twin() -> Result<(), Unmatched> {
             .create_subscription::<GaugeComparison>(&compare_topic, Some(compare_qos))
             .expect("subscription");
 
-        tokio::time::timeout(Duration::from_secs(60), setter.wait_for_service(&node))
-            .await
-            .map_err(|_| Unmatched)?;
         let refused = call(
             &node,
             &setter,
@@ -362,6 +362,5 @@ fn control_the_twin() -> Result<(), Unmatched> {
             seen.1
         );
         assert!((seen.3 - (seen.2 - seen.1)).abs() < 1e-12);
-        Ok(())
-    })
+    });
 }
