@@ -216,3 +216,53 @@ fn sps_viscosity(rho: f32, ii_d: f32) -> f32 {
 fn vand_viscosity(c_v: f32) -> f32 {
     return params.sediment.mu_w * exp(2.5 * c_v / (1.0 - 39.0 / 64.0 * c_v));
 }
+
+// What the rheology pass chooses a sediment particle's region from (`RegionInputs` in pass.rs).
+struct RegionInputs {
+    shields_only: bool,
+    held_before: bool,
+    at_surface: bool,
+    tau_b: f32,
+    tau_bcr: f32,
+    sqrt_j2: f32,
+    tau_y: f32,
+    c_v: f32,
+}
+
+// A sediment particle's region (Figure 2 with the hold; `sediment_region` in pass.rs): in the
+// Shields-only mode suspended below the concentration, else bed load or held; in the
+// Drucker-Prager mode a particle held before stays un-yielded unless Shields makes it bed load
+// (only yield_release frees it otherwise), any other is bed load, yielded or not, and then
+// suspended below the concentration unless un-yielded.
+fn sediment_region(r: RegionInputs) -> u32 {
+    let bed_load = r.at_surface && r.tau_b > r.tau_bcr;
+    if (r.shields_only) {
+        if (r.c_v < SUSPENSION_CONCENTRATION) {
+            return REGION_SUSPENDED;
+        }
+        return select(REGION_UNYIELDED, REGION_BED_LOAD, bed_load);
+    }
+    if (r.held_before && !bed_load) {
+        return REGION_UNYIELDED;
+    }
+    var region = select(REGION_UNYIELDED, REGION_YIELDED, r.sqrt_j2 > r.tau_y);
+    if (bed_load) {
+        region = REGION_BED_LOAD;
+    }
+    if (region != REGION_UNYIELDED && r.c_v < SUSPENSION_CONCENTRATION) {
+        region = REGION_SUSPENDED;
+    }
+    return region;
+}
+
+// The apparent viscosity of a sediment particle in `region`, capped, Pa s (`apparent_viscosity`
+// in suspension.rs, then the cap).
+fn region_viscosity(region: u32, ii_d: f32, tau_y: f32, tau_bcr: f32, c_v: f32) -> f32 {
+    var mu: f32;
+    switch (region) {
+        case REGION_BED_LOAD: { mu = hbp_viscosity(ii_d, tau_bcr); }
+        case REGION_SUSPENDED: { mu = vand_viscosity(c_v); }
+        default: { mu = hbp_viscosity(ii_d, tau_y); }
+    }
+    return min(mu, params.sediment.mu_max);
+}

@@ -150,17 +150,12 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dt_i = 3.0e38;
     if (mobile_i) {
         acc += params.gravity.xyz;
-        let a = length(acc);
-        if (a > 0.0 && !velocity_imposed(pos_i.xyz, phase_i)) {
-            dt_i = sqrt(h / a);
-        }
-        dt_i = min(dt_i, h / (params.c0 + visc_max));
+        let force_bound = !velocity_imposed(pos_i.xyz, phase_i);
+        dt_i = stable_step(h, params.c0, length(acc), force_bound, visc_max);
         if (multiphase) {
             // The explicit viscous limit with the particle's own apparent viscosity.
             let mu_app = textureLoad(stress_b, texel(i), 0).z;
-            if (mu_app > 0.0) {
-                dt_i = min(dt_i, 0.125 * h * h * rho_i / mu_app);
-            }
+            dt_i = min(dt_i, viscous_step(h, rho_i, mu_app));
         }
     } else {
         acc = vec3<f32>(0.0);

@@ -126,37 +126,13 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
             tau_bcr = k * theta * sd.submerged_weight * sd.d50;
         }
         let c_v = clamp(sediment_volume / mixture_volume, 0.0, 1.0);
-        let bed_load = at_surface && tau_b > tau_bcr;
-        if (sd.shields_only != 0u) {
-            if (c_v < SUSPENSION_CONCENTRATION) {
-                region = REGION_SUSPENDED;
-            } else if (bed_load) {
-                region = REGION_BED_LOAD;
-            } else {
-                region = REGION_UNYIELDED;
-            }
-        } else {
-            // Read before this thread writes it; no other thread writes this id's word.
-            let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
-            if (bed_load) {
-                region = REGION_BED_LOAD;
-            } else if (held_before) {
-                // Only the yield_release stage, by the stress of the moving neighbours.
-                region = REGION_UNYIELDED;
-            } else {
-                let sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
-                region = select(REGION_UNYIELDED, REGION_YIELDED, sqrt_j2 > tau_y);
-            }
-            if (region != REGION_UNYIELDED && c_v < SUSPENSION_CONCENTRATION) {
-                region = REGION_SUSPENDED;
-            }
-        }
-        switch (region) {
-            case REGION_BED_LOAD: { mu = hbp_viscosity(ii_d, tau_bcr); }
-            case REGION_SUSPENDED: { mu = vand_viscosity(c_v); }
-            default: { mu = hbp_viscosity(ii_d, tau_y); }
-        }
-        mu = min(mu, sd.mu_max);
+        // Read before this thread writes it; no other thread writes this id's word.
+        let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
+        let sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
+        region = sediment_region(RegionInputs(
+            sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v
+        ));
+        mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
     }
     // Shields-only holds carry no stress; Drucker-Prager holds keep theirs (hold.rs).
     let held = region == REGION_UNYIELDED;

@@ -15,6 +15,7 @@ use crate::physics::integrate::{Particle, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
 use crate::physics::sediment::pass::REGION_HELD;
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
+use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -236,36 +237,33 @@ impl CpuEngine {
     }
 }
 
-/// The variable time step of `dt_update.wgsl`: dt = CFL min(dt_force, dt_sound, dt_visc),
-/// landing exactly on the chunk's target time; zero once the chunk is over.
+/// The variable time step of `dt_update.wgsl` ([`next_step`]); the step is zero once the chunk
+/// is over.
 pub fn dt_update(params: &SimParams, st: &mut StepState) {
     let stable = f32::from_bits(st.dt_min_bits);
     st.dt_min_bits = f32::MAX.to_bits();
-    let mut dt = params.cfl * stable.min(params.dt_visc);
-    let remaining = st.t_target - st.t_rel;
-    if st.status != 0 || remaining <= 0.0 {
-        st.dt = 0.0;
-        return;
+    let next = next_step(
+        params.cfl,
+        stable,
+        params.dt_visc,
+        params.dt_min,
+        st.t_rel,
+        st.t_target,
+        st.status != 0,
+    );
+    match next {
+        NextStep::Stop => st.dt = 0.0,
+        NextStep::Collapse => {
+            st.status |= Health::DT_COLLAPSE;
+            st.dt = 0.0;
+        }
+        NextStep::Step { dt, t_next, cfl_dt } => {
+            st.last_dt = cfl_dt;
+            st.dt = dt;
+            st.dt_prev = st.dt_taken;
+            st.dt_taken = dt;
+            st.t_rel = t_next;
+            st.steps += 1;
+        }
     }
-    // NaN is a collapse too.
-    if dt.is_nan() || dt < params.dt_min {
-        st.status |= Health::DT_COLLAPSE;
-        st.dt = 0.0;
-        return;
-    }
-    st.last_dt = dt;
-    let mut t_next = st.t_rel + dt;
-    if dt >= remaining {
-        dt = remaining;
-        t_next = st.t_target;
-    } else if 2.0 * dt > remaining {
-        // Two equal steps rather than a full one and a sliver.
-        dt = 0.5 * remaining;
-        t_next = st.t_rel + dt;
-    }
-    st.dt = dt;
-    st.dt_prev = st.dt_taken;
-    st.dt_taken = dt;
-    st.t_rel = t_next;
-    st.steps += 1;
 }

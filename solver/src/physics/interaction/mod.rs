@@ -15,6 +15,7 @@ use super::boundary::{WallSums, density};
 use super::eos::{pressure, tait_b};
 use super::kernel::Wendland;
 use super::lanes::{Lanes, Mask, Real, pack};
+use super::timestep::stable_step;
 use super::{Params, Viscosity};
 
 /// Result of one force pass, one entry per particle.
@@ -363,14 +364,8 @@ impl<'a> PairModel<'a> {
             *a += g;
         }
         let a = dot3(acc, acc).sqrt();
-        let h = params.h;
-        let dt_force = if a > 0.0 && force_bound {
-            (h / a).sqrt()
-        } else {
-            f32::INFINITY
-        };
-        let dt_sound = h / (params.c0 + sum.visc_max);
-        ([acc[0], acc[1], acc[2], sum.drho], dt_force.min(dt_sound))
+        let dt = stable_step(params.h, params.c0, a, force_bound, sum.visc_max);
+        ([acc[0], acc[1], acc[2], sum.drho], dt)
     }
 }
 

@@ -214,6 +214,48 @@ pub fn classify_shields_only(at_surface: bool, tau_b: f32, tau_bcr: f32, c_v: f3
     }
 }
 
+/// What the rheology pass chooses a sediment particle's region from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RegionInputs {
+    /// The Shields-only mode (the rest held), or Drucker-Prager with Shields.
+    pub shields_only: bool,
+    /// Held after the previous pass.
+    pub held_before: bool,
+    /// The surface test of Eq. 26.
+    pub at_surface: bool,
+    /// Bed shear stress and its critical value on the local slope, Pa.
+    pub tau_b: f32,
+    pub tau_bcr: f32,
+    /// The stress invariant the particle carries and its Drucker-Prager yield stress, Pa.
+    pub sqrt_j2: f32,
+    pub tau_y: f32,
+    /// Volumetric concentration (Eq. 32).
+    pub c_v: f32,
+}
+
+/// A sediment particle's region as the rheology pass chooses it: [`classify_shields_only`] in
+/// that mode; in the Drucker-Prager mode a particle held before stays un-yielded unless
+/// Shields makes it bed load (only [`super::hold::release_pass`] frees it otherwise), and any
+/// other is classified by Figure 2 ([`classify`]). The GPU's `sediment_region` in
+/// `shaders/common/sediment.wgsl` is compared with it input by input (`tests/wgsl_functions.rs`).
+pub fn sediment_region(r: &RegionInputs) -> Region {
+    if r.shields_only {
+        classify_shields_only(r.at_surface, r.tau_b, r.tau_bcr, r.c_v)
+    } else if r.held_before && !(r.at_surface && r.tau_b > r.tau_bcr) {
+        Region::Unyielded
+    } else {
+        classify(
+            true,
+            r.at_surface,
+            r.tau_b,
+            r.tau_bcr,
+            r.sqrt_j2,
+            r.tau_y,
+            r.c_v,
+        )
+    }
+}
+
 fn norm3(a: [f32; 3]) -> f32 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
@@ -474,15 +516,17 @@ impl<'a> Rheology<'a> {
             ..
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
-        let region = if model.shields_only {
-            classify_shields_only(at_surface, tau_b, tau_bcr, c_v)
-        } else if held_before && !(at_surface && tau_b > tau_bcr) {
-            Region::Unyielded
-        } else {
-            let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
-            let sqrt_j2 = 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt();
-            classify(true, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v)
-        };
+        let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
+        let region = sediment_region(&RegionInputs {
+            shields_only: model.shields_only,
+            held_before,
+            at_surface,
+            tau_b,
+            tau_bcr,
+            sqrt_j2: 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt(),
+            tau_y,
+            c_v,
+        });
         let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
         (
             region as u32,
