@@ -128,7 +128,11 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
         let c_v = clamp(sediment_volume / mixture_volume, 0.0, 1.0);
         // Read before this thread writes it; no other thread writes this id's word.
         let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
-        let sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
+        // The stress the particle carries, which only the Drucker-Prager mode reads.
+        var sqrt_j2 = 0.0;
+        if (sd.shields_only == 0u) {
+            sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
+        }
         region = sediment_region(RegionInputs(
             sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v
         ));

@@ -516,14 +516,20 @@ impl<'a> Rheology<'a> {
             ..
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
-        let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
+        // The stress the particle carries, which only the Drucker-Prager mode reads.
+        let sqrt_j2 = if model.shields_only {
+            0.0
+        } else {
+            let mu_y = hbp_viscosity(ii_d, tau_y, mat.hbp_m, mat.hbp_n, mat.mu_s_pa_s);
+            2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt()
+        };
         let region = sediment_region(&RegionInputs {
             shields_only: model.shields_only,
             held_before,
             at_surface,
             tau_b,
             tau_bcr,
-            sqrt_j2: 2.0 * mu_y.min(model.mu_max) * ii_d.max(0.0).sqrt(),
+            sqrt_j2,
             tau_y,
             c_v,
         });
