@@ -62,7 +62,7 @@ where
 /// take a while). ros2-client 0.12's `wait_for_service` future can miss the match it waits
 /// for: it wakes only on a graph event, and its spinner drops events when the future's 8-event
 /// channel is full, as it likely is while this side's dozen endpoints match at once. Seen here in one
-/// run of five to ten (the future still waiting after 60 s while a fresh one resolved at once,
+/// run of four to ten (the future still waiting after 60 s while a fresh one resolved at once,
 /// the endpoints long matched). A fresh future reads the match state when it is made, so
 /// each second starts a new one.
 async fn served<Req, Resp>(node: &Node, client: &ros2_client::service::Client<Req, Resp>)
