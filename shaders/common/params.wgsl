@@ -29,7 +29,7 @@ struct Sediment {
     phi: f32,                // internal friction angle, rad
     mu_max: f32,             // cap on the apparent viscosity, Pa s
     submerged_weight: f32,   // (rho_s - rho_w) |g|, N/m3 (Eq. 16 without theta and d)
-    pad1: f32,
+    pickup_per_s: f32,       // van Rijn's pick-up rate per unit T^1.5, 1/s (0: Shields releases at once)
 }
 
 // The open flume (2-D); enabled == 0 for a closed tank.

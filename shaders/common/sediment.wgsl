@@ -227,15 +227,43 @@ struct RegionInputs {
     sqrt_j2: f32,
     tau_y: f32,
     c_v: f32,
+    picked_up: bool,  // its mass picked up this step; always where Shields releases at once
+}
+
+// The PCG hash (Jarzynski & Olano 2020), `pcg` in pickup.rs.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// The uniform 32-bit draw of particle `id` at run step `step` (`pickup_draw` in pickup.rs).
+fn pickup_draw(id: u32, step: u32) -> u32 {
+    return pcg(id ^ pcg(step));
+}
+
+// van Rijn's pick-up rate of one particle, 1/s (`pickup_rate` in pickup.rs).
+fn pickup_rate(tau_b: f32, tau_bcr: f32) -> f32 {
+    let stage = max(tau_b / tau_bcr - 1.0, 0.0);
+    return params.sediment.pickup_per_s * stage * sqrt(stage);
+}
+
+// Whether particle `id` is picked up at run step `step`, a step of `dt` at `rate` per second
+// (`picked_up` in pickup.rs).
+fn picked_up(id: u32, step: u32, rate: f32, dt: f32) -> bool {
+    let chance = clamp(rate * dt, 0.0, 0.99999994);
+    return pickup_draw(id, step) < u32(chance * 4294967296.0);
 }
 
 // A sediment particle's region (Figure 2 with the hold; `sediment_region` in pass.rs): in the
 // Shields-only mode suspended below the concentration, else bed load or held; in the
 // Drucker-Prager mode a particle held before stays un-yielded unless Shields makes it bed load
 // (only yield_release frees it otherwise), any other is bed load, yielded or not, and then
-// suspended below the concentration unless un-yielded.
+// suspended below the concentration unless un-yielded. A particle held before that has not been
+// picked up is not bed load.
 fn sediment_region(r: RegionInputs) -> u32 {
-    let bed_load = r.at_surface && r.tau_b > r.tau_bcr;
+    let waits = r.held_before && !r.picked_up;
+    let bed_load = r.at_surface && r.tau_b > r.tau_bcr && !waits;
     if (r.shields_only) {
         if (r.c_v < SUSPENSION_CONCENTRATION) {
             return REGION_SUSPENDED;

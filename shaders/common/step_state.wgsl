@@ -32,8 +32,8 @@ struct StepState {
     parked: atomic<u32>,        // particles parked in this chunk (open flume)
     excluded: atomic<u32>,      // particles excluded for a density out of range in this chunk
     excluded_sediment: atomic<u32>, // of which sediment (they are recycled as water)
-    pad0: u32,
-    pad1: u32,
+    run_steps: u32,             // steps taken before this chunk since the run started, wrapping
+    pad: u32,
     excluded_log: array<ExcludedParticle, EXCLUDED_LOG_LEN>, // the first ones of the chunk
 }
 

@@ -133,8 +133,15 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (sd.shields_only == 0u) {
             sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
         }
+        // The pass before the step's size is chosen draws the pick-ups, one draw a step.
+        var picked = sd.pickup_per_s == 0.0;
+        if (!picked && BEFORE_DT) {
+            let step = state.run_steps + state.steps;
+            picked = picked_up(ids[i], step, pickup_rate(tau_b, tau_bcr), state.dt_taken);
+        }
         region = sediment_region(RegionInputs(
-            sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v
+            sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
+            picked
         ));
         mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
     }

@@ -2,8 +2,8 @@
 //! CPU backend and the oracle call, input by input on the adapter (lavapipe in CI): the kernel,
 //! the equation of state, the time step (each particle's stable step and the step rule), the
 //! Shields solve (critical Shields parameter, friction velocity,
-//! slope factors), the HBP, Vand and Drucker-Prager laws, and the choice of a sediment
-//! particle's region and its viscosity. A stage test compares whole passes on one particle
+//! slope factors), the HBP, Vand and Drucker-Prager laws, the pick-up (its draw, its rate and
+//! the choice), and the choice of a sediment particle's region and its viscosity. A stage test compares whole passes on one particle
 //! set; here each function meets a grid of inputs that reaches its branches and its edges
 //! (the Shields jump at Re* = 500, the sub-layer, the suspension threshold), so a function
 //! changed on one side only fails here even where no particle of a stage test goes.
@@ -18,17 +18,19 @@
 mod common;
 
 use common::{case_path, gpu, gpu_lock, reference_params, reference_sediment};
+use flume_solver::config::Erosion;
 use flume_solver::contract::SimParams;
 use flume_solver::gpu::{buffers, shader};
 use flume_solver::physics::eos::pressure;
 use flume_solver::physics::kernel::Wendland;
 use flume_solver::physics::sediment::drucker_prager::{alpha, kappa_c, yield_stress};
-use flume_solver::physics::sediment::pass::{
-    RegionInputs, SedimentModel, sediment_region, skeleton_pressure, slope_factors,
-};
+use flume_solver::physics::sediment::pass::{SedimentModel, skeleton_pressure, slope_factors};
+use flume_solver::physics::sediment::pickup::{picked_up, pickup_draw, pickup_rate};
 use flume_solver::physics::sediment::rheology::hbp_viscosity;
 use flume_solver::physics::sediment::shields::{critical_shields, friction_velocity};
-use flume_solver::physics::sediment::suspension::{apparent_viscosity, vand_viscosity};
+use flume_solver::physics::sediment::suspension::{
+    RegionInputs, apparent_viscosity, sediment_region, vand_viscosity,
+};
 use flume_solver::physics::timestep::{NextStep, next_step, particle_viscous_bound, stable_step};
 use flume_solver::physics::{Params, eos};
 use flume_solver::{Backend, Case, GpuContext, Region, Simulation};
@@ -44,8 +46,9 @@ const SHARED: &[&str] = &[
     "common/sediment.wgsl",
 ];
 
-/// The Louvain dam break (Drucker-Prager with Shields, HBP m = 100, n = 1.2) at dp = 1 cm: its
-/// uniform block, and the physics the oracle reads from the case file.
+/// The Louvain dam break (Drucker-Prager with Shields, HBP m = 100, n = 1.2) at dp = 1 cm, its
+/// sand picked up at van Rijn's rate (the case releases it at once, which leaves the rate 0):
+/// its uniform block, and the physics the oracle reads from the case file.
 struct Probe {
     gpu: std::sync::Arc<GpuContext>,
     uniform: SimParams,
@@ -58,6 +61,11 @@ fn probe() -> Option<Probe> {
     let mut case = Case::from_path(&case_path("../launch_configs/louvain_dambreak.yaml"))
         .expect("case parses");
     case.numerics.dp_m = 0.01;
+    for phase in &mut case.phases {
+        if let Some(sediment) = &mut phase.sediment {
+            sediment.erosion = Erosion::VanRijnPickup;
+        }
+    }
     let sim = Simulation::new(Backend::Cpu { threads: 1 }, &case).expect("the case runs");
     Some(Probe {
         gpu,
@@ -359,11 +367,11 @@ fn the_sediment_laws() {
     );
 }
 
-/// Every combination of mode, hold, surface, Shields and Drucker-Prager on either side of
-/// their thresholds, and concentrations either side of 0.3.
+/// Every combination of mode, hold, pick-up, surface, Shields and Drucker-Prager on either side
+/// of their thresholds, and concentrations either side of 0.3.
 fn region_inputs() -> Vec<RegionInputs> {
     let mut all = Vec::new();
-    for mode in 0..4 {
+    for mode in 0..8 {
         for at_surface in [false, true] {
             for tau_b in [0.5, 1.0, 2.0] {
                 for sqrt_j2 in [0.0, 5.0, 6.0] {
@@ -377,6 +385,7 @@ fn region_inputs() -> Vec<RegionInputs> {
                             sqrt_j2,
                             tau_y: 5.0,
                             c_v,
+                            picked_up: mode & 4 != 0,
                         });
                     }
                 }
@@ -395,22 +404,21 @@ fn the_region_and_its_viscosity() {
     let packed: Vec<Input> = inputs
         .iter()
         .map(|r| {
+            let modes = flag(r.shields_only) + 2.0 * flag(r.held_before);
             [
-                [
-                    flag(r.shields_only),
-                    flag(r.held_before),
-                    flag(r.at_surface),
-                    r.tau_b,
-                ],
+                [modes, flag(r.picked_up), flag(r.at_surface), r.tau_b],
                 [r.tau_bcr, r.sqrt_j2, r.tau_y, r.c_v],
             ]
         })
         .collect();
-    let regions = p.run(
-        "vec4<f32>(f32(sediment_region(RegionInputs(a.x > 0.5, a.y > 0.5, a.z > 0.5, a.w, \
-         b.x, b.y, b.z, b.w))), 0.0, 0.0, 0.0)",
-        &packed,
-    );
+    let helper = "fn region_probe(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    let m = u32(a.x);
+    let r = RegionInputs((m & 1u) != 0u, (m & 2u) != 0u, a.z > 0.5, a.w, b.x, b.y, b.z, b.w,
+        a.y > 0.5);
+    return vec4<f32>(f32(sediment_region(r)), 0.0, 0.0, 0.0);
+}
+";
+    let regions = p.run_with(helper, "region_probe(a, b)", &packed);
     for (r, got) in inputs.iter().zip(&regions) {
         assert_eq!(
             got[0] as u32,
@@ -452,6 +460,90 @@ fn the_region_and_its_viscosity() {
             let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, i[1][0], mat);
             [mu.min(mu_max), 0.0, 0.0, 0.0]
         },
+    );
+}
+
+/// The pick-up: the draw's bits for ids and steps from 0 to past 2^31, the rate from below the
+/// threshold to T = 100, and whether a particle is picked up at chances from none to certain.
+#[test]
+fn the_pickup() {
+    let _lock = gpu_lock();
+    let Some(p) = probe() else { return };
+    let ids = [0u32, 1, 7, 4096, 65_535, 1 << 20, 0x8000_0001, u32::MAX];
+    let steps = [0u32, 1, 2, 999, 1 << 16, 0xdead_beef, u32::MAX];
+    let mut pairs = Vec::new();
+    for &id in &ids {
+        for &step in &steps {
+            pairs.push((id, step));
+        }
+    }
+    // The 32-bit values travel as halves, each exact in an f32.
+    let halves = |v: u32| [(v >> 16) as f32, (v & 0xffff) as f32];
+    let packed: Vec<Input> = pairs
+        .iter()
+        .map(|&(id, step)| {
+            let [i1, i0] = halves(id);
+            let [s1, s0] = halves(step);
+            [[i1, i0, s1, s0], [0.0; 4]]
+        })
+        .collect();
+    let helper = "fn draw_probe(a: vec4<f32>) -> vec4<f32> {
+    let id = (u32(a.x) << 16u) | u32(a.y);
+    let d = pickup_draw(id, (u32(a.z) << 16u) | u32(a.w));
+    return vec4<f32>(f32(d >> 16u), f32(d & 0xffffu), 0.0, 0.0);
+}
+";
+    let draws = p.run_with(helper, "draw_probe(a)", &packed);
+    for (&(id, step), got) in pairs.iter().zip(&draws) {
+        let want = halves(pickup_draw(id, step));
+        assert_eq!([got[0], got[1]], want, "the draw of id {id} at step {step}");
+    }
+
+    let per_s = p.model.pickup_per_s;
+    assert!(per_s > 0.0, "the probe's sand is picked up");
+    let rates: Vec<Input> = [0.0, 0.5, 1.0, 1.0001, 1.3, 2.0, 11.0, 101.0]
+        .into_iter()
+        .map(|tau_b| [[tau_b, 1.0, 0.0, 0.0], [0.0; 4]])
+        .collect();
+    p.agree(
+        "pick-up rate",
+        "vec4<f32>(pickup_rate(a.x, a.y), 0.0, 0.0, 0.0)",
+        &rates,
+        1,
+        |i| [pickup_rate(per_s, i[0][0], i[0][1]), 0.0, 0.0, 0.0],
+    );
+
+    let mut chances = Vec::new();
+    for &(id, step) in &pairs {
+        for rate in [0.0, 1e-3, 0.3, 0.5, 0.9, 1.0, 5.0] {
+            let [i1, i0] = halves(id);
+            let [s1, s0] = halves(step);
+            chances.push([[i1, i0, s1, s0], [rate, 1.0, 0.0, 0.0]]);
+        }
+    }
+    let helper = "fn picked_probe(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    let id = (u32(a.x) << 16u) | u32(a.y);
+    let hit = picked_up(id, (u32(a.z) << 16u) | u32(a.w), b.x, b.y);
+    return vec4<f32>(select(0.0, 1.0, hit), 0.0, 0.0, 0.0);
+}
+";
+    let hits = p.run_with(helper, "picked_probe(a, b)", &chances);
+    for (i, got) in chances.iter().zip(&hits) {
+        let id = ((i[0][0] as u32) << 16) | i[0][1] as u32;
+        let step = ((i[0][2] as u32) << 16) | i[0][3] as u32;
+        let want = picked_up(id, step, i[1][0], i[1][1]);
+        assert_eq!(
+            got[0] > 0.5,
+            want,
+            "picked up: id {id}, step {step}, rate {}",
+            i[1][0]
+        );
+    }
+    // Not vacuous: some are picked up and some not.
+    let picked = hits.iter().filter(|h| h[0] > 0.5).count();
+    assert!(
+        picked > chances.len() / 4 && picked < chances.len() * 3 / 4,
+        "{picked}"
     );
 }
 

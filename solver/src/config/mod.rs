@@ -214,6 +214,9 @@ pub struct SedimentConfig {
     pub surface_mass_fraction: f64,
     /// Which yield criteria apply.
     pub criterion: YieldCriterion,
+    /// When a held particle that Shields releases leaves the bed.
+    #[serde(default)]
+    pub erosion: Erosion,
     /// Cap on the apparent viscosity, Pa s. Without it, mu_max = 0.125 h rho_s c0: the
     /// viscosity whose explicit diffusion limit `0.125 h^2 rho / mu` equals the acoustic step
     /// `h / c0`, so the sediment never shortens the time step below what the water needs.
@@ -230,6 +233,18 @@ pub enum YieldCriterion {
     /// Shields at the surface only; sediment that is not eroded or suspended is held fixed
     /// (the paper's flushing and flume cases).
     ShieldsOnly,
+}
+
+/// When a held sediment particle whose bed shear stress passes Shields' threshold is released.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Erosion {
+    /// At once (Eq. 25), as the paper does: a grain's rule.
+    #[default]
+    Threshold,
+    /// At van Rijn's (1984) pick-up rate: a particle is released in a step with the chance that
+    /// the flow picks up its mass from its share of the bed (`physics::sediment::pickup`).
+    VanRijnPickup,
 }
 
 fn default_surface_mass_fraction() -> f64 {

@@ -39,7 +39,7 @@ pub struct SedimentGpu {
     pub phi: f32,
     pub mu_max: f32,
     pub submerged_weight: f32,
-    pub pad1: f32,
+    pub pickup_per_s: f32,
 }
 
 /// `Flume` of `shaders/common/params.wgsl` (units there).
@@ -145,15 +145,20 @@ pub struct StepState {
     pub parked: u32,
     pub excluded: u32,
     pub excluded_sediment: u32,
-    pub pad: [u32; 2],
+    pub run_steps: u32,
+    pub pad: u32,
     pub excluded_log: [ExcludedParticle; EXCLUDED_LOG_LEN],
 }
 
 impl StepState {
-    /// The state at the start of a chunk that ends `t_target` seconds later, `step_base` steps
-    /// (modulo the Verlet Euler period) after the start of the run, the last step having been
-    /// `dt_taken` long and its CFL step `last_dt`.
-    pub fn chunk(t_target: f32, last_dt: f32, dt_taken: f32, step_base: u32) -> StepState {
+    /// The state at the start of a chunk that ends `t_target` seconds later, `run_steps` steps
+    /// (wrapping) and `step_base` steps modulo the Verlet Euler period after the start of the
+    /// run, the last step having been `dt_taken` long and its CFL step `last_dt`.
+    pub fn chunk(
+        t_target: f32,
+        (last_dt, dt_taken): (f32, f32),
+        (run_steps, step_base): (u32, u32),
+    ) -> StepState {
         StepState {
             dt: 0.0,
             t_rel: 0.0,
@@ -169,7 +174,8 @@ impl StepState {
             parked: 0,
             excluded: 0,
             excluded_sediment: 0,
-            pad: [0; 2],
+            run_steps,
+            pad: 0,
             excluded_log: [ExcludedParticle::zeroed(); EXCLUDED_LOG_LEN],
         }
     }

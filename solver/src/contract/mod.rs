@@ -9,7 +9,7 @@ mod blocks;
 pub use blocks::*;
 
 use crate::config::{
-    BoundaryMethod, Case, DensityDiffusion, Integrator, Viscosity, YieldCriterion,
+    BoundaryMethod, Case, DensityDiffusion, Erosion, Integrator, Viscosity, YieldCriterion,
 };
 use crate::derived::{self, Derived};
 use crate::flume::inlet_velocity;
@@ -17,6 +17,7 @@ use crate::health::{RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
 use crate::particles::{Parking, parked_phase};
 use crate::physics::sediment::SedimentParams;
 use crate::physics::sediment::pass::SedimentModel;
+use crate::physics::sediment::pickup::pickup_per_s;
 use bytemuck::Zeroable;
 
 pub fn sim_params(
@@ -204,7 +205,17 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
         phi: phi as f32,
         mu_max: mu_max as f32,
         submerged_weight: ((rho_s - rho_w) * case.gravity_magnitude()) as f32,
-        pad1: 0.0,
+        pickup_per_s: match cfg.erosion {
+            Erosion::Threshold => 0.0,
+            Erosion::VanRijnPickup => pickup_per_s(
+                cfg.d50_m,
+                rho_s,
+                rho_w,
+                water.viscosity_pa_s / rho_w,
+                case.gravity_magnitude(),
+                case.numerics.dp_m,
+            ) as f32,
+        },
     }
 }
 
@@ -235,5 +246,6 @@ pub fn sediment_model(case: &Case, derived: &Derived) -> Option<SedimentModel> {
         water_phase: k_water + 1,
         shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
         mu_max: block.mu_max,
+        pickup_per_s: block.pickup_per_s,
     })
 }

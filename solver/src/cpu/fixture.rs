@@ -80,6 +80,7 @@ fn sediment() -> SedimentModel {
         water_phase: WATER as usize,
         shields_only: false,
         mu_max: 50.0,
+        pickup_per_s: 0.0,
     }
 }
 

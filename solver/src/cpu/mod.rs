@@ -212,7 +212,7 @@ impl Engine for CpuEngine {
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         let (grid, b) = self.sorted();
-        let (mut forces, dt_limit) = self.force_pass(&grid, &b, &b.positions, &b.vel_rho);
+        let (mut forces, dt_limit) = self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), None);
         // Parked particles feel nothing.
         forces.resize(b.ids.len(), [0.0; 4]);
         Ok((by_id(&forces, &b.ids), forces::min_dt(&dt_limit)))

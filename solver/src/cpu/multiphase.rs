@@ -12,13 +12,22 @@ use crate::physics::interaction::phase_index;
 use crate::physics::lanes::{LANES, Lanes};
 use crate::physics::sediment::hold::{Release, Transmitted};
 use crate::physics::sediment::pass::{
-    ParticleRheology, Rheology, RheologySide, RheologySums, SedimentModel,
+    Draws, ParticleRheology, Rheology, RheologySide, RheologySums, SedimentModel,
 };
 use crate::physics::sediment::suspension::Region;
 use rayon::prelude::*;
 
-/// The rheology of the active particles (sorted order, `held_before[i]` from the last pass),
-/// then, with `release`, the release of held sediment.
+/// The held sediment of the last pass and the pick-up draws of this one.
+pub struct Holds<'a> {
+    /// Whether each active particle (sorted order) was held after the last pass.
+    pub before: &'a [bool],
+    /// The particles' ids (sorted order): their draws'.
+    pub ids: &'a [u32],
+    pub draws: Option<Draws>,
+}
+
+/// The rheology of the active particles (sorted order), then, with `release`, the release of
+/// held sediment.
 #[allow(clippy::too_many_arguments)]
 pub fn rheology_pass(
     pool: &rayon::ThreadPool,
@@ -27,10 +36,11 @@ pub fn rheology_pass(
     grid: &Grid,
     pos: &[[f32; 4]],
     vel: &[[f32; 4]],
-    held_before: &[bool],
+    holds: &Holds,
     release: bool,
 ) -> Vec<ParticleRheology> {
-    let pass = Rheology::new(params, model);
+    let held_before = holds.before;
+    let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = held_before.len();
     let (vol, sides): (Vec<f32>, Vec<RheologySide>) = pool.install(|| {
         (0..n)
@@ -46,6 +56,7 @@ pub fn rheology_pass(
         vel,
         vol: &vol,
         sides: &sides,
+        ids: holds.ids,
     };
     // Every slot is written by its block.
     let none = ParticleRheology {
@@ -99,6 +110,7 @@ struct Pairs<'a> {
     vel: &'a [[f32; 4]],
     vol: &'a [f32],
     sides: &'a [RheologySide],
+    ids: &'a [u32],
 }
 
 impl Pairs<'_> {
@@ -114,7 +126,7 @@ impl Pairs<'_> {
             let sums = self.group(&group);
             for (lane, i) in group.range.clone().enumerate() {
                 let s = sums.lane(lane);
-                out[i - first] = pass.finish(&pos[i], &vel[i], &s, held_before[i]);
+                out[i - first] = pass.finish(&pos[i], &vel[i], &s, held_before[i], self.ids[i]);
             }
             start = group.range.end;
         }
@@ -167,6 +179,7 @@ mod tests {
             .expect("a pool of two threads");
         let n = fx.pos.len();
         let held: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
+        let ids: Vec<u32> = (0..n as u32).collect();
         let (params, grid) = (&fx.params, &fx.grid);
         let got = rheology_pass(
             &pool,
@@ -175,7 +188,11 @@ mod tests {
             grid,
             &fx.pos,
             &fx.vel,
-            &held,
+            &Holds {
+                before: &held,
+                ids: &ids,
+                draws: None,
+            },
             false,
         );
         let pass = Rheology::new(params, &fx.sediment);
@@ -194,7 +211,7 @@ mod tests {
                         }
                     });
                 }
-                pass.finish(x, v, &s, held[i])
+                pass.finish(x, v, &s, held[i], ids[i])
             })
             .collect();
         let word_bits = |r: &[ParticleRheology]| -> Vec<(u32, u32, Vec<u32>)> {

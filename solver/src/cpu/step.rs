@@ -6,13 +6,14 @@
 
 use super::forces::{Extra, force_pass, min_dt};
 use super::grid::Grid;
-use super::multiphase::rheology_pass;
+use super::multiphase::{Holds, rheology_pass};
 use super::store::{Event, Store, tally};
 use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
 use crate::contract::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
+use crate::physics::sediment::pass::Draws;
 use crate::physics::sediment::pass::REGION_HELD;
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::{NextStep, next_step};
@@ -46,25 +47,21 @@ impl CpuEngine {
         &mut self,
         grid: &Grid,
         b: &State,
-        pos: &[[f32; 4]],
-        vel: &[[f32; 4]],
+        (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+        draws: Option<Draws>,
     ) -> (Vec<[f32; 4]>, Vec<f32>) {
         let active = grid.active() as usize;
         let start = Instant::now();
         let rheology = self.sediment.as_ref().map(|model| {
-            let holds = self.holds(b);
+            let held = self.holds(b);
+            let holds = Holds {
+                before: &held[..active],
+                ids: &b.ids[..active],
+                draws,
+            };
             let release = self.shape.yield_release;
             let (params, pool) = (&self.model, &self.pool);
-            rheology_pass(
-                pool,
-                params,
-                model,
-                grid,
-                pos,
-                vel,
-                &holds[..active],
-                release,
-            )
+            rheology_pass(pool, params, model, grid, pos, vel, &holds, release)
         });
         if let Some(out) = &rheology {
             for (r, &id) in out.iter().zip(&b.ids) {
@@ -130,7 +127,13 @@ impl CpuEngine {
         let mut forces = Vec::new();
         if st.t_rel < st.t_target && st.status == 0 {
             let dt_limit;
-            (forces, dt_limit) = self.force_pass(&grid, &b, &b.positions, &b.vel_rho);
+            // The pass before the step's size is chosen draws the pick-ups, one draw a step.
+            let draws = Draws {
+                step: st.run_steps.wrapping_add(st.steps),
+                dt_s: st.dt_taken,
+            };
+            (forces, dt_limit) =
+                self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), Some(draws));
             let stable = f32::from_bits(st.dt_min_bits).min(min_dt(&dt_limit));
             st.dt_min_bits = stable.to_bits();
         }
@@ -192,7 +195,7 @@ impl CpuEngine {
         });
         let (x_half, v_half): (Vec<[f32; 4]>, Vec<[f32; 4]>) = half.into_iter().unzip();
         self.timed(STAGE_INTEGRATE, start);
-        let (forces_half, _) = self.force_pass(grid, &b, &x_half, &v_half);
+        let (forces_half, _) = self.force_pass(grid, &b, (&x_half, &v_half), None);
         let start = Instant::now();
         let store = Store::new(&self.params, &self.model);
         // The corrector's rheology pass has set the holds again.

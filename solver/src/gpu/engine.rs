@@ -179,7 +179,7 @@ impl Engine for GpuEngine {
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
-        self.write_state(&StepState::chunk(f32::MAX, 0.0, 0.0, 0));
+        self.write_state(&StepState::chunk(f32::MAX, (0.0, 0.0), (0, 0)));
         // The pass writes the active particles only: parked ones feel nothing.
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&self.buffers.forces, 0, None);

@@ -393,11 +393,12 @@ impl Simulation {
                 .map_or(f64::INFINITY, |f| f.max_span_s(dp));
             let span = remaining.min(max_span);
             let euler_every = u64::from(self.params.euler_every);
+            // The run's step count wraps in the block: the pick-up draws only need it to differ
+            // from step to step.
             let init = StepState::chunk(
                 span as f32,
-                self.last_dt_s as f32,
-                self.dt_taken,
-                (self.steps % euler_every) as u32,
+                (self.last_dt_s as f32, self.dt_taken),
+                (self.steps as u32, (self.steps % euler_every) as u32),
             );
             let state = self.engine.run(init, self.steps_for(span))?;
             self.steps += u64::from(state.steps);

@@ -157,6 +157,19 @@ pub fn reference_sediment(
         water_phase: k_water + 1,
         shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
         mu_max: mu_max as f32,
+        pickup_per_s: match cfg.erosion {
+            flume_solver::config::Erosion::Threshold => 0.0,
+            flume_solver::config::Erosion::VanRijnPickup => {
+                flume_solver::physics::sediment::pickup::pickup_per_s(
+                    cfg.d50_m,
+                    sed.rho0_kg_per_m3,
+                    water.rho0_kg_per_m3,
+                    water.viscosity_pa_s / water.rho0_kg_per_m3,
+                    case.gravity_magnitude(),
+                    case.numerics.dp_m,
+                ) as f32
+            }
+        },
     }
 }
 

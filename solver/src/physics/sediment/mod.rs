@@ -10,6 +10,8 @@
 //!   factors and surface detection (Eqs. 16-26);
 //! - [`suspension`]: volumetric concentration, Vand viscosity and the region classification of
 //!   Figure 2 (Eqs. 32-33);
+//! - [`pickup`]: van Rijn's (1984) pick-up rate, which releases a particle Shields would
+//!   release at the rate the flow lifts its mass (an option; the paper releases it at once);
 //! - [`pass`]: all of it for every particle, and [`hold`]: un-yielded sediment held at rest
 //!   until Drucker-Prager releases it.
 //!
@@ -20,6 +22,7 @@
 pub mod drucker_prager;
 pub mod hold;
 pub mod pass;
+pub mod pickup;
 pub mod rheology;
 pub mod shields;
 pub mod stress;

@@ -7,20 +7,21 @@
 //! Choices the paper leaves open, each stated where it is made:
 //! - the skeleton pressure of Drucker-Prager ([`skeleton_pressure`]);
 //! - what the Shields-only mode does with a sediment particle that is neither eroded nor inside
-//!   the bed ([`classify_shields_only`]);
+//!   the bed ([`classify_shields_only`](super::suspension::classify_shields_only));
 //! - the cap on the apparent viscosity ([`SedimentModel::mu_max`]), and the hold of
 //!   un-yielded sediment that makes up for it ([`super::hold`]);
 //! - the bed slope, from the normal of the sediment-water interface ([`slope_factors`]).
 
 use super::SedimentParams;
 use super::drucker_prager::{alpha, kappa_c, yield_stress};
+use super::pickup::{picked_up, pickup_rate};
 use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
     bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity, k_beta,
     k_gamma, sloped_critical_stress,
 };
 use super::suspension::{
-    Region, SUSPENSION_CONCENTRATION, apparent_viscosity, classify, volume_fraction,
+    Region, RegionInputs, apparent_viscosity, sediment_region, volume_fraction,
 };
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::phase_index;
@@ -44,6 +45,18 @@ pub struct SedimentModel {
     /// thousands of Pa s for the Louvain bed) would need steps 10^2 to 10^3 times shorter than
     /// the acoustic ones.
     pub mu_max: f32,
+    /// van Rijn's pick-up rate per unit `T^1.5`, 1/s ([`super::pickup`]); 0: Shields releases a
+    /// particle at once, as the paper does.
+    pub pickup_per_s: f32,
+}
+
+/// The pick-up draw of a rheology pass: the run's step count (wrapping) and the last step's
+/// length, s. One pass a step draws (the one before the step's size is chosen), so a symplectic
+/// step's second pass takes none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Draws {
+    pub step: u32,
+    pub dt_s: f32,
 }
 
 /// What the rheology pass gives one particle.
@@ -201,61 +214,6 @@ pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
     k_beta(beta, phi, n_s > 0.0) * k_gamma(gamma, phi)
 }
 
-/// Region of a sediment particle in the Shields-only mode: bed load where Eq. 25 holds, then
-/// suspended wherever `c_v < 0.3` (eroded or not: a grain that has left the bed is carried by
-/// the water even when the flow next to it is below the Shields threshold), otherwise held.
-pub fn classify_shields_only(at_surface: bool, tau_b: f32, tau_bcr: f32, c_v: f32) -> Region {
-    if c_v < SUSPENSION_CONCENTRATION {
-        Region::Suspended
-    } else if at_surface && tau_b > tau_bcr {
-        Region::BedLoad
-    } else {
-        Region::Unyielded
-    }
-}
-
-/// What the rheology pass chooses a sediment particle's region from.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RegionInputs {
-    /// The Shields-only mode (the rest held), or Drucker-Prager with Shields.
-    pub shields_only: bool,
-    /// Held after the previous pass.
-    pub held_before: bool,
-    /// The surface test of Eq. 26.
-    pub at_surface: bool,
-    /// Bed shear stress and its critical value on the local slope, Pa.
-    pub tau_b: f32,
-    pub tau_bcr: f32,
-    /// The stress invariant the particle carries and its Drucker-Prager yield stress, Pa.
-    pub sqrt_j2: f32,
-    pub tau_y: f32,
-    /// Volumetric concentration (Eq. 32).
-    pub c_v: f32,
-}
-
-/// A sediment particle's region as the rheology pass chooses it: [`classify_shields_only`] in
-/// that mode; in the Drucker-Prager mode a particle held before stays un-yielded unless
-/// Shields makes it bed load (only [`super::hold::release_pass`] frees it otherwise), and any
-/// other is classified by Figure 2 ([`classify`]). The GPU's `sediment_region` in
-/// `shaders/common/sediment.wgsl` is compared with it input by input (`tests/wgsl_functions.rs`).
-pub fn sediment_region(r: &RegionInputs) -> Region {
-    if r.shields_only {
-        classify_shields_only(r.at_surface, r.tau_b, r.tau_bcr, r.c_v)
-    } else if r.held_before && !(r.at_surface && r.tau_b > r.tau_bcr) {
-        Region::Unyielded
-    } else {
-        classify(
-            true,
-            r.at_surface,
-            r.tau_b,
-            r.tau_bcr,
-            r.sqrt_j2,
-            r.tau_y,
-            r.c_v,
-        )
-    }
-}
-
 fn norm3(a: [f32; 3]) -> f32 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
@@ -297,6 +255,8 @@ pub struct Rheology<'a> {
     b_sed: f32,
     /// `(C_s dp)^2` of water's eddy viscosity, m2 (0: none).
     sps_length2: f32,
+    /// This pass's pick-up draws (none: no particle waiting for its pick-up is released).
+    draws: Option<Draws>,
 }
 
 impl<'a> Rheology<'a> {
@@ -317,9 +277,15 @@ impl<'a> Rheology<'a> {
                 Viscosity::Multiphase { sps_length2, .. } => sps_length2,
                 _ => 0.0,
             },
+            draws: None,
             params,
             model,
         }
+    }
+
+    /// The pass with the pick-up draws `draws`.
+    pub fn with_draws(self, draws: Option<Draws>) -> Rheology<'a> {
+        Rheology { draws, ..self }
     }
 
     fn is_sediment(&self, pos: &[f32; 4]) -> bool {
@@ -420,13 +386,14 @@ impl<'a> Rheology<'a> {
     }
 
     /// Particle i's rheology from its sums, `held_before` whether it was held after the
-    /// previous pass (see [`rheology_pass`]).
+    /// previous pass (see [`rheology_pass`]), `id` its id (its pick-up draw's).
     pub fn finish(
         &self,
         x_i: &[f32; 4],
         v_i: &[f32; 4],
         s: &RheologySums,
         held_before: bool,
+        id: u32,
     ) -> ParticleRheology {
         let params = self.params;
         let phase_i = &params.phases[phase_index(x_i)];
@@ -441,7 +408,7 @@ impl<'a> Rheology<'a> {
         let eps = strain_rate(&s.grad, params.dim);
         let ii_d = second_invariant(&eps);
         let (region, mu, held) = if self.is_sediment(x_i) {
-            self.classify(v_i[3], s, ii_d, held_before)
+            self.classify(v_i[3], s, ii_d, (held_before, id))
         } else {
             let eddy = sps_viscosity(v_i[3], self.sps_length2, ii_d);
             (Region::Water as u32, phase_i.mu + eddy, false)
@@ -493,13 +460,14 @@ impl<'a> Rheology<'a> {
         chain
     }
 
-    /// Region, apparent viscosity and hold of a sediment particle of density `rho_i`.
+    /// Region, apparent viscosity and hold of a sediment particle of density `rho_i`, held
+    /// before or not, of id `id`.
     fn classify(
         &self,
         rho_i: f32,
         s: &RheologySums,
         ii_d: f32,
-        held_before: bool,
+        (held_before, id): (bool, u32),
     ) -> (u32, f32, bool) {
         let (model, mat) = (self.model, &self.model.material);
         let sed = &self.params.phases[model.sediment_phase];
@@ -532,6 +500,7 @@ impl<'a> Rheology<'a> {
             sqrt_j2,
             tau_y,
             c_v,
+            picked_up: self.picked_up(id, tau_b, tau_bcr),
         });
         let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
         (
@@ -539,6 +508,20 @@ impl<'a> Rheology<'a> {
             mu.min(model.mu_max),
             region == Region::Unyielded,
         )
+    }
+}
+
+impl Rheology<'_> {
+    /// Whether particle `id`, under a bed shear stress `tau_b` against its critical `tau_bcr`,
+    /// is picked up in this pass: always where Shields releases at once, never in a pass
+    /// without draws.
+    fn picked_up(&self, id: u32, tau_b: f32, tau_bcr: f32) -> bool {
+        let per_s = self.model.pickup_per_s;
+        if per_s == 0.0 {
+            return true;
+        }
+        self.draws
+            .is_some_and(|d| picked_up(id, d.step, pickup_rate(per_s, tau_b, tau_bcr), d.dt_s))
     }
 }
 
@@ -565,7 +548,7 @@ pub fn rheology_pass(
             for j in 0..pos.len() {
                 pass.add_pair((&pos[i], &vel_rho[i]), (&pos[j], &vel_rho[j]), &mut s);
             }
-            pass.finish(&pos[i], &vel_rho[i], &s, held_before[i])
+            pass.finish(&pos[i], &vel_rho[i], &s, held_before[i], i as u32)
         })
         .collect()
 }
@@ -613,22 +596,5 @@ mod tests {
         // = 1329.255 Pa; effective stress (rho_s - rho_w) g d = 1710 * 9.81 * 0.05 = 838.755 Pa.
         let p = skeleton_pressure(1329.255, 2710.0, 1000.0);
         assert!((p - 838.755).abs() < 1e-2, "{p}");
-    }
-
-    #[test]
-    fn shields_only_regions() {
-        assert_eq!(classify_shields_only(true, 0.5, 0.2, 0.6), Region::BedLoad);
-        assert_eq!(
-            classify_shields_only(true, 0.1, 0.2, 0.6),
-            Region::Unyielded
-        );
-        assert_eq!(
-            classify_shields_only(false, 0.5, 0.2, 0.6),
-            Region::Unyielded
-        );
-        assert_eq!(
-            classify_shields_only(true, 0.1, 0.2, 0.1),
-            Region::Suspended
-        );
     }
 }

@@ -96,6 +96,68 @@ pub fn classify(
     }
 }
 
+/// Region of a sediment particle in the Shields-only mode: bed load where Eq. 25 holds, then
+/// suspended wherever `c_v < 0.3` (eroded or not: a grain that has left the bed is carried by
+/// the water even when the flow next to it is below the Shields threshold), otherwise held.
+pub fn classify_shields_only(at_surface: bool, tau_b: f32, tau_bcr: f32, c_v: f32) -> Region {
+    if c_v < SUSPENSION_CONCENTRATION {
+        Region::Suspended
+    } else if at_surface && tau_b > tau_bcr {
+        Region::BedLoad
+    } else {
+        Region::Unyielded
+    }
+}
+
+/// What the rheology pass chooses a sediment particle's region from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RegionInputs {
+    /// The Shields-only mode (the rest held), or Drucker-Prager with Shields.
+    pub shields_only: bool,
+    /// Held after the previous pass.
+    pub held_before: bool,
+    /// The surface test of Eq. 26.
+    pub at_surface: bool,
+    /// Bed shear stress and its critical value on the local slope, Pa.
+    pub tau_b: f32,
+    pub tau_bcr: f32,
+    /// The stress invariant the particle carries and its Drucker-Prager yield stress, Pa.
+    pub sqrt_j2: f32,
+    pub tau_y: f32,
+    /// Volumetric concentration (Eq. 32).
+    pub c_v: f32,
+    /// Whether the particle's mass has been picked up this step ([`super::pickup`]); always
+    /// true where Shields releases at once, as the paper does.
+    pub picked_up: bool,
+}
+
+/// A sediment particle's region as the rheology pass chooses it: [`classify_shields_only`] in
+/// that mode; in the Drucker-Prager mode a particle held before stays un-yielded unless
+/// Shields makes it bed load (only [`super::hold::release_pass`] frees it otherwise), and any
+/// other is classified by Figure 2 ([`classify`]). In either mode a particle held before that
+/// has not been picked up is not bed load: Shields' release waits for the pick-up. The GPU's
+/// `sediment_region` in `shaders/common/sediment.wgsl` is compared with it input by input
+/// (`tests/wgsl_functions.rs`).
+pub fn sediment_region(r: &RegionInputs) -> Region {
+    let waits = r.held_before && !r.picked_up;
+    let tau_b = if waits { 0.0 } else { r.tau_b };
+    if r.shields_only {
+        classify_shields_only(r.at_surface, tau_b, r.tau_bcr, r.c_v)
+    } else if r.held_before && !(r.at_surface && tau_b > r.tau_bcr) {
+        Region::Unyielded
+    } else {
+        classify(
+            true,
+            r.at_surface,
+            tau_b,
+            r.tau_bcr,
+            r.sqrt_j2,
+            r.tau_y,
+            r.c_v,
+        )
+    }
+}
+
 /// Apparent viscosity of a particle in `region`, Pa s, with `ii_d` the second invariant of its
 /// strain rate (1/s2), `tau_y` and `tau_bcr` its Drucker-Prager and Shields yield stresses (Pa)
 /// and `c_v` its concentration:
@@ -236,5 +298,56 @@ mod tests {
         assert_eq!(mu4, vand_viscosity(c_v, 1e-3));
         let mu5 = apparent_viscosity(Region::Water, ii_d, tau_y, tau_bcr, c_v, &p);
         assert_eq!(mu5, 1e-3);
+    }
+
+    #[test]
+    fn shields_only_regions() {
+        assert_eq!(classify_shields_only(true, 0.5, 0.2, 0.6), Region::BedLoad);
+        assert_eq!(
+            classify_shields_only(true, 0.1, 0.2, 0.6),
+            Region::Unyielded
+        );
+        assert_eq!(
+            classify_shields_only(false, 0.5, 0.2, 0.6),
+            Region::Unyielded
+        );
+        assert_eq!(
+            classify_shields_only(true, 0.1, 0.2, 0.1),
+            Region::Suspended
+        );
+    }
+
+    /// A held particle Shields would release waits for its pick-up in either mode; one that
+    /// was moving goes on moving, picked or not.
+    #[test]
+    fn held_bed_waits_for_its_pickup() {
+        let base = RegionInputs {
+            shields_only: true,
+            held_before: true,
+            at_surface: true,
+            tau_b: 0.5,
+            tau_bcr: 0.2,
+            sqrt_j2: 0.0,
+            tau_y: 10.0,
+            c_v: 0.6,
+            picked_up: false,
+        };
+        for shields_only in [true, false] {
+            let r = RegionInputs {
+                shields_only,
+                ..base
+            };
+            assert_eq!(sediment_region(&r), Region::Unyielded, "{r:?}");
+            let picked = RegionInputs {
+                picked_up: true,
+                ..r
+            };
+            assert_eq!(sediment_region(&picked), Region::BedLoad, "{picked:?}");
+            let moving = RegionInputs {
+                held_before: false,
+                ..r
+            };
+            assert_eq!(sediment_region(&moving), Region::BedLoad, "{moving:?}");
+        }
     }
 }

@@ -1,0 +1,117 @@
+//! Erosion at the rate sand is picked up from its bed, for a particle far larger than a grain.
+//!
+//! The paper releases a surface particle as soon as Shields' criterion holds (Eq. 25). That is a
+//! grain's rule: at dp = 1 cm a particle is a layer 25 grains thick, and when the flow passes
+//! the threshold the whole top row leaves at once, where the flow would pick up a grain at a
+//! time. Here a held particle that Shields would release waits for the mass it holds to be
+//! picked up: it is released in a step with the probability that van Rijn's (1984) pick-up rate
+//! lifts a particle's mass from its share of the bed in that step (Einstein's 1950 view of
+//! entrainment as a chance per grain per unit time). The bed then loses sand at van Rijn's rate
+//! whatever dp is.
+//!
+//! van Rijn, L. C. (1984). Sediment pick-up functions. J. Hydraul. Eng. 110(10), 1494-1502:
+//! `E = 0.00033 rho_s sqrt(Delta g d50) D*^0.3 T^1.5` kg/m2/s, with
+//! `D* = d50 (Delta g / nu^2)^(1/3)`, `T = (tau_b - tau_bcr) / tau_bcr` and
+//! `Delta = rho_s / rho_w - 1`, for 130 <= d50 <= 1500 um.
+//!
+//! A particle of mass `rho_s dp^dim` has `dp^(dim-1)` of bed, so it is picked up at the rate
+//! `E dp^(dim-1) / (rho_s dp^dim) = 0.00033 sqrt(Delta g d50) D*^0.3 T^1.5 / dp` per second.
+//! The draw is a hash of the particle's id and the run's step count, the same on every engine
+//! (`pickup_draw` in `shaders/common/sediment.wgsl`).
+
+/// van Rijn's (1984) pick-up constant, dimensionless.
+pub const VAN_RIJN_PICKUP: f64 = 0.00033;
+
+/// The rate at which a surface particle of size `dp_m` is picked up per unit `T^1.5`, 1/s:
+/// `0.00033 sqrt(Delta g d50) D*^0.3 / dp` (module doc), for grains of `d50_m` and density
+/// `rho_s` in water of density `rho_w` and kinematic viscosity `nu_w` under gravity `g`.
+pub fn pickup_per_s(d50_m: f64, rho_s: f64, rho_w: f64, nu_w: f64, g: f64, dp_m: f64) -> f64 {
+    let delta_g = (rho_s / rho_w - 1.0) * g;
+    let d_star = d50_m * (delta_g / (nu_w * nu_w)).cbrt();
+    VAN_RIJN_PICKUP * (delta_g * d50_m).sqrt() * d_star.powf(0.3) / dp_m
+}
+
+/// The rate at which one particle is picked up, 1/s: `per_s T^1.5` with van Rijn's transport
+/// stage `T = tau_b / tau_bcr - 1` (0 at or below the threshold).
+pub fn pickup_rate(per_s: f32, tau_b: f32, tau_bcr: f32) -> f32 {
+    let stage = (tau_b / tau_bcr - 1.0).max(0.0);
+    per_s * stage * stage.sqrt()
+}
+
+/// A uniform 32-bit draw for particle `id` at run step `step`: the PCG hash (Jarzynski & Olano
+/// 2020, "Hash functions for GPU rendering", JCGT 9(3)) of the id mixed with the hashed step.
+pub fn pickup_draw(id: u32, step: u32) -> u32 {
+    pcg(id ^ pcg(step))
+}
+
+fn pcg(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// Whether particle `id` is picked up at run step `step`, a step of `dt_s` at `rate` per second:
+/// its draw falls under `rate dt` of the 32-bit range (below one step in 4e9: never).
+pub fn picked_up(id: u32, step: u32, rate: f32, dt_s: f32) -> bool {
+    let chance = (rate * dt_s).clamp(0.0, LARGEST_CHANCE);
+    pickup_draw(id, step) < (chance * 4_294_967_296.0) as u32
+}
+
+/// The largest chance of a step, just under 1, whose share of the 32-bit range is a u32.
+const LARGEST_CHANCE: f32 = 0.999_999_94;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ULBRA sand (d50 0.4 mm, 2710 kg/m3) in water at 20 C, dp = 1 cm, by hand:
+    /// Delta g = 1.71 x 9.81 = 16.775 m/s2; D* = 4e-4 (16.775 / 1e-12)^(1/3) = 10.240;
+    /// D*^0.3 = 2.0095; sqrt(Delta g d50) = 0.081915 m/s; so 0.00033 x 0.081915 x 2.0095 / 0.01
+    /// = 5.432e-3 per second.
+    #[test]
+    fn pickup_per_second_of_the_flume_sand() {
+        let per_s = pickup_per_s(4e-4, 2710.0, 1000.0, 1e-6, 9.81, 0.01);
+        assert!((per_s - 5.432e-3).abs() < 1e-6, "{per_s}");
+        // The mass flux it stands for is van Rijn's E whatever dp: E = rate rho_s dp.
+        let at_4mm = pickup_per_s(4e-4, 2710.0, 1000.0, 1e-6, 9.81, 0.004);
+        assert!((at_4mm * 0.004 - per_s * 0.01).abs() < 1e-12);
+    }
+
+    /// T = 0.5: 3 x 0.5^1.5 = 1.06066; T = 3: 3 x 3^1.5 = 15.5885; at or below the threshold
+    /// nothing is picked up.
+    #[test]
+    fn rate_goes_with_the_transport_stage() {
+        assert!((pickup_rate(3.0, 1.5, 1.0) - 1.060_66).abs() < 1e-6);
+        assert!((pickup_rate(3.0, 0.8, 0.2) - 15.588_46).abs() < 1e-4);
+        assert_eq!(pickup_rate(3.0, 1.0, 1.0), 0.0);
+        assert_eq!(pickup_rate(3.0, 0.5, 1.0), 0.0);
+        assert_eq!(pickup_rate(3.0, 0.0, f32::INFINITY), 0.0);
+    }
+
+    /// The draw's first values, worked out apart (in Python's integers, modulo 2^32) from the
+    /// published constants: pcg(0) = 129708002, pcg(pcg(0)) = 817759070; and the mix of id and
+    /// step differs when either changes.
+    #[test]
+    fn draw_is_the_pcg_hash() {
+        assert_eq!(pcg(0), 129_708_002);
+        assert_eq!(pickup_draw(0, 0), 817_759_070);
+        assert_ne!(pickup_draw(1, 0), pickup_draw(0, 0));
+        assert_ne!(pickup_draw(0, 1), pickup_draw(0, 0));
+    }
+
+    /// Over many steps a particle is picked up as often as its rate says: 1e5 steps at a
+    /// chance of 1e-2 give 1000 +/- 3 sigma (95).
+    #[test]
+    fn picked_up_as_often_as_the_rate_says() {
+        let hits = (0..100_000u32)
+            .filter(|&step| picked_up(7, step, 100.0, 1e-4))
+            .count();
+        assert!((905..=1095).contains(&hits), "{hits}");
+        let ids = (0..100_000u32)
+            .filter(|&id| picked_up(id, 12, 100.0, 1e-4))
+            .count();
+        assert!((905..=1095).contains(&ids), "{ids}");
+        assert!(!(0..10_000u32).any(|s| picked_up(3, s, 0.0, 1e-4)));
+        assert!((0..10_000u32).all(|s| picked_up(3, s, 1e9, 1.0)));
+    }
+}
