@@ -96,6 +96,14 @@ fn wall_density(rho: f32, f_w: f32, phase: u32) -> f32 {
     return max(r, params.phases[phase].rho0);
 }
 
+// Whether held sediment stands as a wall (`bed_is_boundary` in cpu/step.rs): the Shields-only
+// mode's holds under the generalised wall condition, with the multiphase model that holds them.
+fn held_bed_is_wall() -> bool {
+    let sd = params.sediment;
+    return params.boundary_mode == 1u && params.viscosity_mode == 2u && sd.phase != 0u
+        && sd.shields_only != 0u;
+}
+
 // An inlet buffer particle's density: the one it entered with, or under the generalised wall
 // condition its own by continuity, without tension (cpu/store.rs, inlet_density).
 fn inlet_density(entered: f32, integrated: f32, phase: u32) -> f32 {

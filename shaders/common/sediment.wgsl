@@ -260,10 +260,12 @@ fn picked_up(id: u32, step: u32, rate: f32, dt: f32) -> bool {
 // Drucker-Prager mode a particle held before stays un-yielded unless Shields makes it bed load
 // (only yield_release frees it otherwise), any other is bed load, yielded or not, and then
 // suspended below the concentration unless un-yielded. A particle held before that has not been
-// picked up is not bed load.
+// picked up stays held.
 fn sediment_region(r: RegionInputs) -> u32 {
-    let waits = r.held_before && !r.picked_up;
-    let bed_load = r.at_surface && r.tau_b > r.tau_bcr && !waits;
+    if (r.held_before && !r.picked_up) {
+        return REGION_UNYIELDED;
+    }
+    let bed_load = r.at_surface && r.tau_b > r.tau_bcr;
     if (r.shields_only) {
         if (r.c_v < SUSPENSION_CONCENTRATION) {
             return REGION_SUSPENDED;

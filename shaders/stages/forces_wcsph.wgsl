@@ -4,7 +4,8 @@
 // al. 1997) viscosity or the divergence of the viscous stress of the rheology pass (multiphase,
 // Eq. 10 with sigma = -p I + tau), gravity; DBC walls (Crespo et al. 2007) only gather density,
 // or under the generalised wall condition (Adami et al. 2012) the fluid's pressure around them,
-// and get the density that gives it in place of a rate.
+// and get the density that gives it in place of a rate; so does held sediment in the
+// Shields-only mode under that condition.
 // Also the per-particle stable step of the variable time step, min-reduced into `state`.
 // Reference: solver/src/physics/interaction.rs.
 
@@ -34,6 +35,12 @@ fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
     return mat3x3<f32>(a.xyz, vec3<f32>(a.y, a.w, b.x), vec3<f32>(a.z, b.x, b.y)) * (1.0 / (rho * rho));
 }
 
+// Whether the rheology pass held particle i (sorted order) fixed: its region word is the stress
+// texel's w.
+fn held_here(i: u32) -> bool {
+    return (u32(textureLoad(stress_b, texel(i), 0).w) & REGION_HELD) != 0u;
+}
+
 // The corrector's half-step forces do not set the step: only the predictor's do (DualSPHysics).
 override REDUCE_DT: bool = true;
 
@@ -48,7 +55,9 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pos_i = textureLoad(positions, texel(i), 0);
     let vr_i = textureLoad(vel_rho, texel(i), 0);
     let phase_i = bitcast<u32>(pos_i.w);
-    let mobile_i = params.phases[phase_i].mobile > 0.5;
+    // Held sediment may stand as a wall (cpu/step.rs, bed_is_boundary).
+    let bed_walls = held_bed_is_wall();
+    let mobile_i = params.phases[phase_i].mobile > 0.5 && !(bed_walls && held_here(i));
     let rho_i = vr_i.w;
     let press_i = momentum_pressure(rho_i, phase_i) / (rho_i * rho_i);
     let h = params.h;
@@ -84,7 +93,7 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let phase_j = bitcast<u32>(pos_j.w);
-            let mobile_j = params.phases[phase_j].mobile > 0.5;
+            let mobile_j = params.phases[phase_j].mobile > 0.5 && !(bed_walls && held_here(j));
             if (!mobile_i && !mobile_j) {
                 continue;
             }

@@ -34,6 +34,10 @@ fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     var rho = vr.w * (2.0 - eps) / (2.0 + eps);
     if (ph.mobile < 0.5) {
         rho = wall_density(rho, f.w, phase);
+    } else if (held_bed_is_wall() && is_held(ids_n[i])) {
+        // A held bed that stands as a wall takes its force pass's density (bed_wall in
+        // integrate.rs).
+        rho = max(f.w, ph.rho0);
     }
     ids_out[i] = ids_n[i];
     let v = vr.xyz + dt * f.xyz;

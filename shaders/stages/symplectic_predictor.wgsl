@@ -38,8 +38,11 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * u, p.w));
         textureStore(vel_rho_half, texel(i), vec4<f32>(u, inlet_density(vr.w, rho, phase)));
     } else if (params.phases[phase].mobile > 0.5 && (regions[ids_n[i]] & REGION_HELD_BIT) != 0u) {
+        // A held bed that stands as a wall takes its force pass's density (bed_wall in
+        // integrate.rs).
+        let r = select(rho, max(f.w, params.phases[phase].rho0), held_bed_is_wall());
         textureStore(positions_half, texel(i), p);
-        textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, rho));
+        textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, r));
     } else if (params.phases[phase].mobile > 0.5) {
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * vr.xyz, p.w));
         let r = select(rho, max(rho, params.phases[phase].rho0), params.clamp_pressure != 0u);

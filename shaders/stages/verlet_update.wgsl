@@ -45,6 +45,10 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     var rho = base.w + span * f.w;
     if (ph.mobile < 0.5) {
         rho = wall_density(rho, f.w, phase);
+    } else if (held_bed_is_wall() && is_held(ids_n[i])) {
+        // A held bed that stands as a wall takes its force pass's density (bed_wall in
+        // integrate.rs).
+        rho = max(f.w, ph.rho0);
     }
     ids_out[i] = ids_n[i];
     // Held sediment is at rest in both interleaved sequences: a particle held at n and

@@ -14,7 +14,8 @@
 //! rho_j`: water feels sand of Tait pressure p as water of pressure `p rho_w / rho_s`, and at
 //! equal compression sand's Tait pressure is `rho_s / rho_w` times water's. So the load the bed
 //! carries, as the water feels it, is the Tait ratio times `rho_w / rho_s`
-//! ([`BedContact::felt_over_load`]).
+//! ([`BedContact::felt_over_load`]). A held bed that stands as a wall (`physics::boundary`) is
+//! felt as walls are, at its own pressure: the ratio itself.
 
 use crate::config::Case;
 use crate::derived::{Derived, tait_b};
@@ -57,7 +58,8 @@ pub struct Wet {
 #[derive(Clone, Debug, PartialEq)]
 pub struct BedContact {
     pub columns: Vec<Column>,
-    /// `rho_w / rho_s`: the share of a sand particle's Tait pressure the water feels.
+    /// The share of a held sand particle's Tait pressure the water feels: `rho_w / rho_s`, or 1
+    /// where the held bed stands as a wall.
     pub felt_factor: f64,
 }
 
@@ -147,7 +149,11 @@ pub fn bed_contact(
         .collect();
     Some(BedContact {
         columns,
-        felt_factor: rho_w / rho_s,
+        felt_factor: if case.held_bed_is_wall() {
+            1.0
+        } else {
+            rho_w / rho_s
+        },
     })
 }
 

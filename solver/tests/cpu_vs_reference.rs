@@ -71,6 +71,11 @@ fn two_verlet_steps_with_held_sand_match_the_oracle() {
 }
 
 #[test]
+fn two_verlet_steps_with_the_held_bed_as_a_wall_match_the_oracle() {
+    common::held_bed::check_verlet_steps_with_held_bed_walls(&CPU);
+}
+
+#[test]
 fn rheology_matches_the_oracle_drucker_prager_shields() {
     stages::check_rheology(&CPU, case("tests/cases/sediment_bed_2d.yaml"), 21);
 }

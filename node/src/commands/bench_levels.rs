@@ -407,7 +407,9 @@ fn print_bed(sim: &Simulation, case: &Case, particles: &Particles, regions: &[u3
     let push = match (contact.median_tait_over_load(), contact.felt_over_load()) {
         (Some(tait), Some(felt)) => format!(
             "; the top sand's Tait pressure over the water's weight: median {tait:.2}, as the \
-             water feels it (x rho_w / rho_s) {felt:.2} (goal 0.75-1.25)"
+             water feels it (x {:.3}: a wall's is felt whole, a dynamic boundary's as \
+             rho_w / rho_s) {felt:.2} (goal 0.75-1.25)",
+            contact.felt_factor
         ),
         _ => String::new(),
     };

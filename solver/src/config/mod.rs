@@ -485,6 +485,18 @@ impl Case {
         Some((sediment, water))
     }
 
+    /// Whether held sediment stands as a wall (`physics::boundary`): the Shields-only mode's
+    /// holds under the generalised wall condition.
+    pub fn held_bed_is_wall(&self) -> bool {
+        self.numerics.boundary == BoundaryMethod::Generalised
+            && self.sediment_phases().is_some_and(|(k, _)| {
+                self.phases[k]
+                    .sediment
+                    .as_ref()
+                    .is_some_and(|s| s.criterion == YieldCriterion::ShieldsOnly)
+            })
+    }
+
     /// Top of the highest sediment block, m, as written in the case.
     pub fn bed_top_m(&self) -> Option<f64> {
         let d = self.dim();

@@ -11,7 +11,7 @@ use super::store::{Event, Store, tally};
 use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
 use crate::contract::{SimParams, StepState};
 use crate::health::Health;
-use crate::physics::integrate::{Particle, correct, predict, verlet_step};
+use crate::physics::integrate::{Particle, bed_wall, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
 use crate::physics::sediment::pass::Draws;
 use crate::physics::sediment::pass::REGION_HELD;
@@ -26,6 +26,13 @@ impl CpuEngine {
         let mut grid = self.grid();
         let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
         (grid, self.a.gather(&order))
+    }
+
+    /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass and
+    /// stands as a wall ([`CpuEngine::bed_is_boundary`]).
+    fn bed_walls(&self, b: &State) -> Vec<bool> {
+        let walls = self.bed_is_boundary();
+        self.holds(b).into_iter().map(|h| h && walls).collect()
     }
 
     /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
@@ -76,14 +83,19 @@ impl CpuEngine {
         let start = Instant::now();
         let model = PairModel::new(&self.model);
         let store = Store::new(&self.params, &self.model);
+        let bed_walls = self.bed_is_boundary();
         let (sides, imposed): (Vec<Side>, Vec<bool>) = self.pool.install(|| {
             (0..active)
                 .into_par_iter()
                 .map(|i| {
                     let imposed = store.velocity_imposed(&pos[i]);
+                    let side = model.side(&pos[i], &vel[i]);
+                    // The held bed stands as a wall does (`physics::boundary`).
+                    let wall = bed_walls && rheology.as_ref().is_some_and(|r| r[i].held);
                     let side = Side {
                         imposed,
-                        ..model.side(&pos[i], &vel[i])
+                        mobile: side.mobile && !wall,
+                        ..side
                     };
                     (side, imposed)
                 })
@@ -157,6 +169,7 @@ impl CpuEngine {
         let (dt, dt_prev) = (st.dt, st.dt_prev);
         let store = Store::new(&self.params, &self.model);
         let holds = self.holds(&b);
+        let bed_walls = self.bed_walls(&b);
         let buffers = std::mem::take(&mut self.a);
         let next = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
@@ -166,7 +179,11 @@ impl CpuEngine {
             };
             let held = holds[i];
             let phase = store.phase(x);
-            let moved = verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f);
+            let moved = if bed_walls[i] {
+                bed_wall(phase, x, f)
+            } else {
+                verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f)
+            };
             let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
             // Held sediment is at rest in both of the leapfrog's sequences.
             let prev = if held { [0.0, 0.0, 0.0, v[3]] } else { *v };
@@ -180,6 +197,7 @@ impl CpuEngine {
         let dt = st.dt;
         let store = Store::new(&self.params, &self.model);
         let holds = self.holds(&b);
+        let bed_walls = self.bed_walls(&b);
         let half: Vec<Particle> = self.pool.install(|| {
             (0..b.ids.len())
                 .into_par_iter()
@@ -188,7 +206,11 @@ impl CpuEngine {
                     let Some(f) = forces.get(i) else {
                         return (*x, *v);
                     };
-                    let free = predict(store.phase(x), dt, x, v, f);
+                    let free = if bed_walls[i] {
+                        bed_wall(store.phase(x), x, f)
+                    } else {
+                        predict(store.phase(x), dt, x, v, f)
+                    };
                     store.half_step(x, v, holds[i], 0.5 * dt, free)
                 })
                 .collect()
@@ -200,18 +222,31 @@ impl CpuEngine {
         let store = Store::new(&self.params, &self.model);
         // The corrector's rheology pass has set the holds again.
         let holds = self.holds(&b);
+        let bed_walls = self.bed_walls(&b);
         let buffers = std::mem::take(&mut self.a);
         let next = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
             let Some(f) = forces_half.get(i) else {
                 return ((*x, *v), b.vel_rho_prev[i], Event::default());
             };
-            let moved = correct(store.phase(x), dt, x, v, v_half[i][3], f);
+            let moved = if bed_walls[i] {
+                bed_wall(store.phase(x), x, f)
+            } else {
+                correct(store.phase(x), dt, x, v, v_half[i][3], f)
+            };
             let (out, event) = store.apply(b.ids[i], x, v, holds[i], dt, moved);
             (out, b.vel_rho_prev[i], event)
         });
         self.a = State { ids: b.ids, ..next };
         self.timed(STAGE_INTEGRATE, start);
+    }
+
+    /// Whether held sediment stands as a wall: the paper's Shields-only mode holds it as
+    /// boundary particles, and under the generalised wall condition it takes the fluid's
+    /// pressure as the walls do (`physics::boundary`). Drucker-Prager's held sand carries the
+    /// bed's own stress and keeps its density by continuity.
+    fn bed_is_boundary(&self) -> bool {
+        self.model.generalised_walls && self.sediment.as_ref().is_some_and(|m| m.shields_only)
     }
 
     /// Stores each particle (`store_one(i)`: where it goes, its velocity of the step

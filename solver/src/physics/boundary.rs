@@ -12,11 +12,16 @@
 //! flume: 2,734 to 2,783 kg/m3 in 40 s, eight times the weight of the water above it). Here
 //! the boundary pushes back exactly as hard as the fluid presses, every step, with no memory.
 //!
-//! Only walls take it. Held sediment taken as such a boundary too (tried on the CI flume, dp =
-//! 1 cm, 60 s) kept no gap under the flow and carried the weight of the water above it (1.05
-//! times), but with the flow no longer held off it Shields released the bed row after row down
-//! to the floor, where water then leaked through in three columns: the held bed's boundary
-//! waits for the scour model's own account of how much sand moves.
+//! Held sediment in the paper's Shields-only mode takes it too: the paper holds the sand that is
+//! not eroded as fixed boundary particles, and as a dynamic boundary it held the flow 2 dp off
+//! the bed and pushed it up (its density by continuity ratcheting up to 8 times the weight of
+//! the water above it). As a wall (`bed_is_boundary` in `cpu/step.rs`, `held_bed_is_wall` in
+//! `params.wgsl`) it carries the water's weight with no gap. Under the paper's release at once
+//! the flow then released the bed row after row down to the floor (measured on the CI flume,
+//! dp = 1 cm, 60 s, in an earlier trial): the bed wants the release at the rate the flow picks
+//! sand up (`sediment::pickup`). Drucker-Prager's held sand carries the bed's own stress and
+//! keeps its density by continuity: its skeleton pressure needs the weight of the sand above it,
+//! which a boundary condition would not give a particle with no fluid around it.
 //!
 //! A wall particle with no fluid within 2h is dry: it takes rest density (p = 0), touching
 //! nothing that reads it. The fluid particles of an inlet buffer are left out of the sums:

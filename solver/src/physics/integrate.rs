@@ -18,6 +18,14 @@ fn wall_density(phase: &Phase, rho: f32, f: &[f32; 4]) -> f32 {
     rho.max(phase.rho0)
 }
 
+/// A held sediment particle of a bed that stands as a wall (the Shields-only mode under the
+/// generalised wall condition): at `x`, at rest, with the density its force pass gave it
+/// (`f[3]`, `physics::boundary`), never below rest, as a wall. It replaces the integrator's
+/// step for that particle (`held_bed_wall` in the WGSL integrators).
+pub fn bed_wall(phase: &Phase, x: &[f32; 4], f: &[f32; 4]) -> Particle {
+    (*x, [0.0, 0.0, 0.0, f[3].max(phase.rho0)])
+}
+
 /// One particle's predictor half step: its position and velocity-density at t + dt/2 from
 /// those at t and its forces `f` at t. A wall keeps its position and velocity, and
 /// `rho >= rho0`.

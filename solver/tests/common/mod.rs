@@ -2,6 +2,7 @@
 
 #![allow(dead_code)]
 
+pub mod held_bed;
 pub mod parked;
 pub mod stages;
 

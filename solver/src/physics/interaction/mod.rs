@@ -374,6 +374,18 @@ impl<'a> PairModel<'a> {
 /// Panics if the slices differ in length or a phase index is outside `params.phases`; both are
 /// bugs of the caller, not bad input data.
 pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Interaction {
+    interact_with_bed_walls(params, pos, vel_rho, &[])
+}
+
+/// [`interact`] with the particles `bed_walls[i]` (none past its end) standing as walls: the
+/// held sediment of the Shields-only mode under the generalised wall condition
+/// (`physics::boundary`), which then gets its density from the fluid around it as a wall does.
+pub fn interact_with_bed_walls(
+    params: &Params,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+    bed_walls: &[bool],
+) -> Interaction {
     assert_eq!(
         pos.len(),
         vel_rho.len(),
@@ -383,7 +395,15 @@ pub fn interact(params: &Params, pos: &[[f32; 4]], vel_rho: &[[f32; 4]]) -> Inte
     let sides: Vec<Side> = pos
         .iter()
         .zip(vel_rho)
-        .map(|(p, v)| model.side(p, v))
+        .enumerate()
+        .map(|(i, (p, v))| {
+            let side = model.side(p, v);
+            let wall = bed_walls.get(i).copied().unwrap_or(false);
+            Side {
+                mobile: side.mobile && !wall,
+                ..side
+            }
+        })
         .collect();
     let mut forces = Vec::with_capacity(pos.len());
     let mut dt_limit = Vec::with_capacity(pos.len());

@@ -71,6 +71,11 @@ impl<'a> StressDivergence<'a> {
 
     /// Adds neighbour j's term to mobile particle i's acceleration `acc`.
     pub fn add_pair(&self, i: &StressSide, j: &StressSide, acc: &mut [f32; 3]) {
+        self.add_pair_as(i, (j, false), acc);
+    }
+
+    /// [`StressDivergence::add_pair`] with j a wall whatever its phase when `bed_wall`.
+    fn add_pair_as(&self, i: &StressSide, (j, bed_wall): (&StressSide, bool), acc: &mut [f32; 3]) {
         let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
         let r2 = x_ij[0] * x_ij[0] + x_ij[1] * x_ij[1] + x_ij[2] * x_ij[2];
         if r2 >= self.support2 || r2 < self.coincident2 {
@@ -78,7 +83,7 @@ impl<'a> StressDivergence<'a> {
         }
         let phases = &self.params.phases;
         let phase_j = &phases[j.phase as usize];
-        let m_j = if phase_j.mobile {
+        let m_j = if phase_j.mobile && !bed_wall {
             phase_j.mass
         } else {
             phase_j.mass * wall_scale(phases[i.phase as usize].rho0, phase_j.rho0)
@@ -126,16 +131,30 @@ pub fn stress_divergence(
     vel_rho: &[[f32; 4]],
     rheology: &[ParticleRheology],
 ) -> Vec<[f32; 3]> {
+    stress_divergence_with_bed_walls(params, pos, vel_rho, rheology, &[])
+}
+
+/// [`stress_divergence`] with the particles `bed_walls[i]` (none past its end) standing as walls
+/// (`interaction::interact_with_bed_walls`): zero for them, and their mass scaled as a wall's
+/// in their neighbours' terms.
+pub fn stress_divergence_with_bed_walls(
+    params: &Params,
+    pos: &[[f32; 4]],
+    vel_rho: &[[f32; 4]],
+    rheology: &[ParticleRheology],
+    bed_walls: &[bool],
+) -> Vec<[f32; 3]> {
     let div = StressDivergence::new(params);
     let sides: Vec<StressSide> = (0..pos.len())
         .map(|i| div.side(&pos[i], vel_rho[i][3], &rheology[i].stress))
         .collect();
+    let wall = |i: usize| bed_walls.get(i).copied().unwrap_or(false);
     (0..pos.len())
         .map(|i| {
             let mut acc = [0.0_f32; 3];
-            if params.phases[phase_index(&pos[i])].mobile {
-                for j in &sides {
-                    div.add_pair(&sides[i], j, &mut acc);
+            if params.phases[phase_index(&pos[i])].mobile && !wall(i) {
+                for (j, side_j) in sides.iter().enumerate() {
+                    div.add_pair_as(&sides[i], (side_j, wall(j)), &mut acc);
                 }
             }
             acc

@@ -135,21 +135,24 @@ pub struct RegionInputs {
 /// that mode; in the Drucker-Prager mode a particle held before stays un-yielded unless
 /// Shields makes it bed load (only [`super::hold::release_pass`] frees it otherwise), and any
 /// other is classified by Figure 2 ([`classify`]). In either mode a particle held before that
-/// has not been picked up is not bed load: Shields' release waits for the pick-up. The GPU's
+/// has not been picked up stays held: Shields' release waits for the pick-up, and so does
+/// suspension (a top row thinned by the pick-ups would otherwise fall below the concentration
+/// of suspension at once, and the water reach the floor through it). The GPU's
 /// `sediment_region` in `shaders/common/sediment.wgsl` is compared with it input by input
 /// (`tests/wgsl_functions.rs`).
 pub fn sediment_region(r: &RegionInputs) -> Region {
-    let waits = r.held_before && !r.picked_up;
-    let tau_b = if waits { 0.0 } else { r.tau_b };
+    if r.held_before && !r.picked_up {
+        return Region::Unyielded;
+    }
     if r.shields_only {
-        classify_shields_only(r.at_surface, tau_b, r.tau_bcr, r.c_v)
-    } else if r.held_before && !(r.at_surface && tau_b > r.tau_bcr) {
+        classify_shields_only(r.at_surface, r.tau_b, r.tau_bcr, r.c_v)
+    } else if r.held_before && !(r.at_surface && r.tau_b > r.tau_bcr) {
         Region::Unyielded
     } else {
         classify(
             true,
             r.at_surface,
-            tau_b,
+            r.tau_b,
             r.tau_bcr,
             r.sqrt_j2,
             r.tau_y,
@@ -317,8 +320,8 @@ mod tests {
         );
     }
 
-    /// A held particle Shields would release waits for its pick-up in either mode; one that
-    /// was moving goes on moving, picked or not.
+    /// A held particle Shields would release, or whose concentration is that of suspension,
+    /// waits for its pick-up in either mode; one that was moving goes on moving, picked or not.
     #[test]
     fn held_bed_waits_for_its_pickup() {
         let base = RegionInputs {
@@ -338,6 +341,8 @@ mod tests {
                 ..base
             };
             assert_eq!(sediment_region(&r), Region::Unyielded, "{r:?}");
+            let thin = RegionInputs { c_v: 0.1, ..r };
+            assert_eq!(sediment_region(&thin), Region::Unyielded, "{thin:?}");
             let picked = RegionInputs {
                 picked_up: true,
                 ..r

@@ -1,0 +1,77 @@
+//! The held bed standing as a wall (the Shields-only mode under the generalised wall condition,
+//! `flume_solver::physics::boundary`), for any backend: two Verlet steps of a sand bed in
+//! motion under water against the oracle, whose force pass takes each step's held sand as walls
+//! (`interaction::interact_with_bed_walls`) and whose integrator gives them the density that
+//! pass gave (`integrate::bed_wall`).
+
+use super::stages::{assert_step_close, sediment_in_motion, shields_only_case};
+use flume_solver::Backend;
+use flume_solver::config::BoundaryMethod;
+use flume_solver::physics::sediment::{pass, stress};
+use flume_solver::physics::{integrate, interaction};
+
+pub fn check_verlet_steps_with_held_bed_walls(backend: &Backend) {
+    let mut c = shields_only_case();
+    c.numerics.boundary = BoundaryMethod::Generalised;
+    let (mut sim, particles, params) = sediment_in_motion(backend, &c, 29);
+    let model = super::reference_sediment(&sim);
+    let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
+    sim.advance_to(f64::from(dt)).expect("step 1");
+    sim.advance_to(f64::from(dt) + f64::from(dt2))
+        .expect("step 2");
+    assert_eq!(sim.steps(), 2);
+    let after = sim.read_particles().expect("readback");
+
+    let n = particles.len();
+    let forces = |pos: &[[f32; 4]], vel: &[[f32; 4]], held_before: &[bool]| {
+        let r = pass::rheology_pass(&params, &model, pos, vel, held_before);
+        let held: Vec<bool> = r.iter().map(|r| r.held).collect();
+        let mut f = interaction::interact_with_bed_walls(&params, pos, vel, &held).forces;
+        for (f, s) in f.iter_mut().zip(stress::stress_divergence_with_bed_walls(
+            &params, pos, vel, &r, &held,
+        )) {
+            for k in 0..3 {
+                f[k] += s[k];
+            }
+        }
+        (f, held)
+    };
+    // The holds of the step from `pos`, `vel` under forces `f`, the held bed a wall, and the
+    // case's clamp on free particles' densities.
+    let walls = |(pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+                 f: &[[f32; 4]],
+                 held: &[bool],
+                 s: &mut integrate::VerletState| {
+        let phases = &params.phases;
+        integrate::hold_at_rest(phases, params.clamp_negative_pressure, pos, vel, held, s);
+        for i in 0..n {
+            let phase = &phases[pos[i][3].to_bits() as usize];
+            if held[i] {
+                s.1[i][3] = integrate::bed_wall(phase, &pos[i], &f[i]).1[3];
+            } else if phase.mobile && params.clamp_negative_pressure {
+                // No tension: a free particle's density stays at or above rest.
+                s.1[i][3] = s.1[i][3].max(phase.rho0);
+            }
+        }
+    };
+    let (pos0, vel0) = (&particles.positions, &particles.vel_rho);
+    let (f0, held1) = forces(pos0, vel0, &vec![false; n]);
+    let mut s1 = integrate::verlet(&params.phases, dt, 0.0, true, pos0, vel0, vel0, &f0);
+    walls((pos0, vel0), &f0, &held1, &mut s1);
+    let (f1, held2) = forces(&s1.0, &s1.1, &held1);
+    let mut s2 = integrate::verlet(&params.phases, dt2, dt, false, &s1.0, &s1.1, &s1.2, &f1);
+    walls((&s1.0, &s1.1), &f1, &held2, &mut s2);
+    assert_step_close(&after, &s2.0, &s2.1, &[&f0, &f1], dt, 2.0);
+    // Not vacuous: sand held in both steps that stands under water takes the water's pressure,
+    // a density above rest.
+    let pressed = (0..n)
+        .filter(|&i| held1[i] && held2[i])
+        .filter(|&i| s2.1[i][3] > params.phases[pos0[i][3].to_bits() as usize].rho0)
+        .count();
+    eprintln!(
+        "held {} then {}; {pressed} held in both take the water's pressure",
+        held1.iter().filter(|&&h| h).count(),
+        held2.iter().filter(|&&h| h).count()
+    );
+    assert!(pressed > 0, "no held sand takes the water's pressure");
+}
