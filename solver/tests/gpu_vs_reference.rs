@@ -82,6 +82,11 @@ fn two_verlet_steps_with_the_held_bed_as_a_wall_match_the_cpu_steps() {
 }
 
 #[test]
+fn two_symplectic_steps_with_the_held_bed_as_a_wall_match_the_cpu_backend() {
+    on_gpu(common::held_bed::check_symplectic_steps_with_held_bed_walls);
+}
+
+#[test]
 fn rheology_matches_the_cpu_drucker_prager_shields() {
     on_gpu(|b| stages::check_rheology(b, case("tests/cases/sediment_bed_2d.yaml"), 21));
 }
