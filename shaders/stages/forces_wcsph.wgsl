@@ -35,6 +35,21 @@ fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
     return mat3x3<f32>(a.xyz, vec3<f32>(a.y, a.w, b.x), vec3<f32>(a.z, b.x, b.y)) * (1.0 / (rho * rho));
 }
 
+// The contact force per unit mass of a held-bed particle of phase `phase_j` on a particle of
+// another phase r2 away,
+// over x_ij (`add_contact` in interaction/mod.rs): Monaghan's (1994) D ((r0 / r)^12 - (r0 /
+// r)^4) / r^2 within r0 = dp / sqrt(2), D = (c0 / 10)^2, dp from the phase's particle volume.
+fn wall_contact(r2: f32, phase_j: u32) -> f32 {
+    let v0 = params.phases[phase_j].mass / params.phases[phase_j].rho0;
+    let r0_2 = 0.5 * select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
+    if (r2 >= r0_2) {
+        return 0.0;
+    }
+    let q2 = r0_2 / r2;
+    let q4 = q2 * q2;
+    return 0.01 * params.c0 * params.c0 * (q4 * q4 * q4 - q4) / r2;
+}
+
 // Whether the rheology pass held particle i (sorted order) fixed: its region word is the stress
 // texel's w.
 fn held_here(i: u32) -> bool {
@@ -118,6 +133,9 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                     wall_rho_r += vr_j.w * dx * w;
                 }
                 continue;
+            }
+            if (generalised && !mobile_j && params.phases[phase_j].mobile > 0.5 && phase_j != phase_i) {
+                acc += wall_contact(r2, phase_j) * dx;
             }
             if (params.diffusion_mode != 0u && mobile_j && phase_j == phase_i) {
                 var rho_h = 0.0;

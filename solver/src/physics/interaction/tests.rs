@@ -303,3 +303,46 @@ fn three_d_uses_z_as_vertical() {
     // Pressure acts along z only.
     assert_eq!(out.forces[0][..2], [0.0, 0.0]);
 }
+
+/// The held bed's contact force by hand: dp = 1 cm, c0 = 10 m/s, so D = 1 m2/s2 and r0^2 =
+/// dp^2 / 2 = 5e-5 m2 (the sand's particle volume is dp^2 too). A water particle 0.5 dp above
+/// a held sand particle standing as a wall, both at rest density (no pressure) and at rest:
+/// (r0 / r)^2 = 2, so the force is D (2^6 - 2^2) / r = 60 / 0.005 = 12 000 m/s2 straight up,
+/// under the generalised condition only; none at 0.75 dp (beyond r0 = 0.707 dp), none on sand
+/// of the bed's own phase, none from a wall.
+#[test]
+fn held_bed_contact_force_by_hand() {
+    let dp = 0.01;
+    let h = smoothing_length(1.2, 2, f64::from(dp)) as f32;
+    let mut params = params_2d(h, 10.0, 1000.0 * dp * dp);
+    params.gravity = [0.0; 3];
+    let sand = Phase {
+        rho0: 2710.0,
+        mass: 2710.0 * dp * dp,
+        ..water(0.0)
+    };
+    params.phases.push(sand);
+    const SAND: usize = 2;
+    let up = |params: &Params, gap: f32, (above, below): (usize, usize)| {
+        let pos = [at(0.0, gap, above), at(0.0, 0.0, below)];
+        let rest = |phase: usize| [0.0, 0.0, 0.0, params.phases[phase].rho0];
+        let vel = [rest(above), rest(below)];
+        interact_with_bed_walls(params, &pos, &vel, &[false, below == SAND]).forces[0][1]
+    };
+    assert_eq!(
+        up(&params, 0.5 * dp, (WATER, SAND)),
+        0.0,
+        "none under DBC walls"
+    );
+    params.generalised_walls = true;
+    params.phases[WALL].generalised_wall = true;
+    let a = up(&params, 0.5 * dp, (WATER, SAND));
+    assert!(close(a, 12_000.0, 1e-5), "{a}");
+    assert_eq!(up(&params, 0.75 * dp, (WATER, SAND)), 0.0);
+    assert_eq!(
+        up(&params, 0.5 * dp, (SAND, SAND)),
+        0.0,
+        "on the bed's own sand"
+    );
+    assert_eq!(up(&params, 0.5 * dp, (WATER, WALL)), 0.0, "from a wall");
+}
