@@ -96,7 +96,7 @@ fn wall_density(rho: f32, f_w: f32, phase: u32) -> f32 {
     return max(r, params.phases[phase].rho0);
 }
 
-// Whether held sediment stands as a wall (`bed_is_boundary` in cpu/step.rs): the Shields-only
+// Whether held sediment stands as a wall (`SimParams::held_bed_is_wall`): the Shields-only
 // mode's holds under the generalised wall condition, with the multiphase model that holds them.
 fn held_bed_is_wall() -> bool {
     let sd = params.sediment;

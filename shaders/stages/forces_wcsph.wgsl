@@ -35,13 +35,18 @@ fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
     return mat3x3<f32>(a.xyz, vec3<f32>(a.y, a.w, b.x), vec3<f32>(a.z, b.x, b.y)) * (1.0 / (rho * rho));
 }
 
-// The contact force per unit mass of a held-bed particle of phase `phase_j` on a particle of
-// another phase r2 away,
-// over x_ij (`add_contact` in interaction/mod.rs): Monaghan's (1994) D ((r0 / r)^12 - (r0 /
-// r)^4) / r^2 within r0 = dp / sqrt(2), D = (c0 / 10)^2, dp from the phase's particle volume.
-fn wall_contact(r2: f32, phase_j: u32) -> f32 {
-    let v0 = params.phases[phase_j].mass / params.phases[phase_j].rho0;
-    let r0_2 = 0.5 * select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
+// r0^2 = dp^2 / 2 of the held bed's contact force, dp from the sand's particle volume
+// (`PhaseConsts::contact2` in interaction/mod.rs).
+fn bed_contact_r0_2() -> f32 {
+    let sand = params.phases[params.sediment.phase];
+    let v0 = sand.mass / sand.rho0;
+    return 0.5 * select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
+}
+
+// The contact force per unit mass of a held-bed particle on a particle of another phase r2
+// away, over x_ij (`add_contact` in interaction/mod.rs): Monaghan's (1994) D ((r0 / r)^12 -
+// (r0 / r)^4) / r^2 within r0, D = (c0 / 10)^2.
+fn bed_contact(r2: f32, r0_2: f32) -> f32 {
     if (r2 >= r0_2) {
         return 0.0;
     }
@@ -72,6 +77,10 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let phase_i = bitcast<u32>(pos_i.w);
     // Held sediment may stand as a wall (cpu/step.rs, bed_is_boundary).
     let bed_walls = held_bed_is_wall();
+    var bed_r0_2 = 0.0;
+    if (bed_walls) {
+        bed_r0_2 = bed_contact_r0_2();
+    }
     let mobile_i = params.phases[phase_i].mobile > 0.5 && !(bed_walls && held_here(i));
     let rho_i = vr_i.w;
     let press_i = momentum_pressure(rho_i, phase_i) / (rho_i * rho_i);
@@ -134,8 +143,9 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
                 continue;
             }
-            if (generalised && !mobile_j && params.phases[phase_j].mobile > 0.5 && phase_j != phase_i) {
-                acc += wall_contact(r2, phase_j) * dx;
+            // Only held sand is a wall of a mobile phase.
+            if (bed_walls && !mobile_j && params.phases[phase_j].mobile > 0.5 && phase_j != phase_i) {
+                acc += bed_contact(r2, bed_r0_2) * dx;
             }
             if (params.diffusion_mode != 0u && mobile_j && phase_j == phase_i) {
                 var rho_h = 0.0;

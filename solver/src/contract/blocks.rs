@@ -232,6 +232,16 @@ pub fn order_key(x: f32) -> u32 {
 impl SimParams {
     /// The pair and particle formulas' parameters (`solver::physics`) for this uniform, of a
     /// case in `dim` dimensions with `n_phases` phases (walls included).
+    /// Whether held sediment stands as a wall (`physics::boundary`): the Shields-only mode's
+    /// holds under the generalised wall condition, with the multiphase model that holds them
+    /// (`held_bed_is_wall` in `params.wgsl`).
+    pub fn held_bed_is_wall(&self) -> bool {
+        self.boundary_mode == BOUNDARY_GENERALISED
+            && self.viscosity_mode == VISCOSITY_MULTIPHASE
+            && self.sediment.phase != 0
+            && self.sediment.shields_only != 0
+    }
+
     pub fn physics(&self, dim: u32, n_phases: usize) -> crate::physics::Params {
         use crate::physics::{Params, Phase, Viscosity};
         Params {

@@ -28,13 +28,6 @@ impl CpuEngine {
         (grid, self.a.gather(&order))
     }
 
-    /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass and
-    /// stands as a wall ([`CpuEngine::bed_is_boundary`]).
-    fn bed_walls(&self, b: &State) -> Vec<bool> {
-        let walls = self.bed_is_boundary();
-        self.holds(b).into_iter().map(|h| h && walls).collect()
-    }
-
     /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
     fn holds(&self, b: &State) -> Vec<bool> {
         let phases = &self.model.phases;
@@ -169,7 +162,7 @@ impl CpuEngine {
         let (dt, dt_prev) = (st.dt, st.dt_prev);
         let store = Store::new(&self.params, &self.model);
         let holds = self.holds(&b);
-        let bed_walls = self.bed_walls(&b);
+        let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
         let next = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
@@ -179,7 +172,7 @@ impl CpuEngine {
             };
             let held = holds[i];
             let phase = store.phase(x);
-            let moved = if bed_walls[i] {
+            let moved = if bed_walls && holds[i] {
                 bed_wall(phase, x, f)
             } else {
                 verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f)
@@ -197,7 +190,7 @@ impl CpuEngine {
         let dt = st.dt;
         let store = Store::new(&self.params, &self.model);
         let holds = self.holds(&b);
-        let bed_walls = self.bed_walls(&b);
+        let bed_walls = self.bed_is_boundary();
         let half: Vec<Particle> = self.pool.install(|| {
             (0..b.ids.len())
                 .into_par_iter()
@@ -206,7 +199,7 @@ impl CpuEngine {
                     let Some(f) = forces.get(i) else {
                         return (*x, *v);
                     };
-                    let free = if bed_walls[i] {
+                    let free = if bed_walls && holds[i] {
                         bed_wall(store.phase(x), x, f)
                     } else {
                         predict(store.phase(x), dt, x, v, f)
@@ -222,14 +215,14 @@ impl CpuEngine {
         let store = Store::new(&self.params, &self.model);
         // The corrector's rheology pass has set the holds again.
         let holds = self.holds(&b);
-        let bed_walls = self.bed_walls(&b);
+        let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
         let next = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
             let Some(f) = forces_half.get(i) else {
                 return ((*x, *v), b.vel_rho_prev[i], Event::default());
             };
-            let moved = if bed_walls[i] {
+            let moved = if bed_walls && holds[i] {
                 bed_wall(store.phase(x), x, f)
             } else {
                 correct(store.phase(x), dt, x, v, v_half[i][3], f)
@@ -246,7 +239,7 @@ impl CpuEngine {
     /// pressure as the walls do (`physics::boundary`). Drucker-Prager's held sand carries the
     /// bed's own stress and keeps its density by continuity.
     fn bed_is_boundary(&self) -> bool {
-        self.model.generalised_walls && self.sediment.as_ref().is_some_and(|m| m.shields_only)
+        self.params.held_bed_is_wall()
     }
 
     /// Stores each particle (`store_one(i)`: where it goes, its velocity of the step

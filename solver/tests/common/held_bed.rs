@@ -4,7 +4,9 @@
 //! (`interaction::interact_with_bed_walls`) and whose integrator gives them the density that
 //! pass gave (`integrate::bed_wall`).
 
-use super::stages::{assert_step_close, sediment_in_motion, shields_only_case};
+use super::stages::{
+    TwoSteps, assert_step_close, sediment_in_motion, shields_only_case, two_steps_of_sand_in_motion,
+};
 use flume_solver::Backend;
 use flume_solver::config::BoundaryMethod;
 use flume_solver::physics::sediment::{pass, stress};
@@ -13,14 +15,14 @@ use flume_solver::physics::{integrate, interaction};
 pub fn check_verlet_steps_with_held_bed_walls(backend: &Backend) {
     let mut c = shields_only_case();
     c.numerics.boundary = BoundaryMethod::Generalised;
-    let (mut sim, particles, params) = sediment_in_motion(backend, &c, 29);
-    let model = super::reference_sediment(&sim);
-    let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
-    sim.advance_to(f64::from(dt)).expect("step 1");
-    sim.advance_to(f64::from(dt) + f64::from(dt2))
-        .expect("step 2");
-    assert_eq!(sim.steps(), 2);
-    let after = sim.read_particles().expect("readback");
+    let TwoSteps {
+        particles,
+        params,
+        model,
+        after,
+        dt,
+        dt2,
+    } = two_steps_of_sand_in_motion(backend, &c, 53);
 
     let n = particles.len();
     let forces = |pos: &[[f32; 4]], vel: &[[f32; 4]], held_before: &[bool]| {
@@ -74,6 +76,21 @@ pub fn check_verlet_steps_with_held_bed_walls(backend: &Backend) {
         held2.iter().filter(|&&h| h).count()
     );
     assert!(pressed > 0, "no held sand takes the water's pressure");
+    // And the held bed's contact force is exercised: water within dp / sqrt(2) of held sand at
+    // the start (this seed has two such pairs).
+    let dp = c.numerics.dp_m as f32;
+    let close = (0..n)
+        .filter(|&i| particles.phase(i) == 1)
+        .flat_map(|i| (0..n).filter(|&j| held1[j]).map(move |j| (i, j)))
+        .filter(|&(i, j)| {
+            let (a, b) = (pos0[i], pos0[j]);
+            (a[0] - b[0]).hypot(a[1] - b[1]) < dp / 2.0_f32.sqrt()
+        })
+        .count();
+    assert!(
+        close > 0,
+        "no water close enough to the held bed to feel its contact force"
+    );
 }
 
 /// The symplectic integrator's branches for the held bed (the predictor's and the corrector's,

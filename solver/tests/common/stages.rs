@@ -426,6 +426,36 @@ pub fn sediment_in_motion(
     (sim, particles, params)
 }
 
+/// A sand bed in motion ([`sediment_in_motion`]) before and after two steps of different
+/// lengths on `backend`, with the oracle's parameters and sediment model.
+pub struct TwoSteps {
+    pub particles: flume_solver::Particles,
+    pub params: flume_solver::physics::Params,
+    pub model: flume_solver::physics::sediment::pass::SedimentModel,
+    pub after: flume_solver::Particles,
+    pub dt: f32,
+    pub dt2: f32,
+}
+
+pub fn two_steps_of_sand_in_motion(backend: &Backend, c: &Case, seed: u64) -> TwoSteps {
+    let (mut sim, particles, params) = sediment_in_motion(backend, c, seed);
+    let model = super::reference_sediment(&sim);
+    let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
+    sim.advance_to(f64::from(dt)).expect("step 1");
+    sim.advance_to(f64::from(dt) + f64::from(dt2))
+        .expect("step 2");
+    assert_eq!(sim.steps(), 2);
+    let after = sim.read_particles().expect("readback");
+    TwoSteps {
+        particles,
+        params,
+        model,
+        after,
+        dt,
+        dt2,
+    }
+}
+
 /// One round of `check_rheology`: the GPU's rheology, release and force passes from the holds
 /// `held` against the CPU's. Returns the holds after it, how many held particles it released
 /// and the count of each region (walls, 1-5).
@@ -551,14 +581,14 @@ pub fn check_rheology(backend: &Backend, c: Case, seed: u64) {
 pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
     use flume_solver::physics::sediment::{hold, pass, stress};
     let c = case("tests/cases/sediment_bed_2d.yaml");
-    let (mut sim, particles, params) = sediment_in_motion(backend, &c, 23);
-    let model = super::reference_sediment(&sim);
-    let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
-    sim.advance_to(f64::from(dt)).expect("step 1");
-    sim.advance_to(f64::from(dt) + f64::from(dt2))
-        .expect("step 2");
-    assert_eq!(sim.steps(), 2);
-    let after = sim.read_particles().expect("readback");
+    let TwoSteps {
+        particles,
+        params,
+        model,
+        after,
+        dt,
+        dt2,
+    } = two_steps_of_sand_in_motion(backend, &c, 23);
 
     let n = particles.len();
     let forces = |pos: &[[f32; 4]], vel: &[[f32; 4]], held_before: &[bool]| {

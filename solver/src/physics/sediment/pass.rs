@@ -526,7 +526,7 @@ impl Rheology<'_> {
 }
 
 /// The rheology of every particle (see the module doc), `held_before[i]` whether particle i was
-/// held after the previous pass. In the Drucker-Prager mode a particle held before stays held
+/// held after the previous pass; a pass without pick-up draws (particle i's id is i). In the Drucker-Prager mode a particle held before stays held
 /// unless Shields makes it bed load: only [`super::hold::release_pass`], which follows this
 /// pass, releases it by the stress of its neighbours.
 ///
