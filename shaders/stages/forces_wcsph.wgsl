@@ -35,12 +35,12 @@ fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
     return mat3x3<f32>(a.xyz, vec3<f32>(a.y, a.w, b.x), vec3<f32>(a.z, b.x, b.y)) * (1.0 / (rho * rho));
 }
 
-// r0^2 = dp^2 / 2 of the held bed's contact force, dp from the sand's particle volume
-// (`PhaseConsts::contact2` in interaction/mod.rs).
+// r0^2 = (0.6 dp)^2 of the held bed's contact force, dp from the sand's particle volume
+// (`CONTACT_REACH` and `PhaseConsts::contact2` in interaction/mod.rs).
 fn bed_contact_r0_2() -> f32 {
     let sand = params.phases[params.sediment.phase];
     let v0 = sand.mass / sand.rho0;
-    return 0.5 * select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
+    return 0.36 * select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
 }
 
 // The contact force per unit mass of a held-bed particle on a particle of another phase r2

@@ -27,9 +27,9 @@
 //! it. Water that got between two rows of the held bed (through a hole a pick-up left, or
 //! skimming the dry bed at the front with no pressure) travelled through the bed, released the
 //! sand it passed and fell through the floor (5 particles in 60 s of the CI flume). So under
-//! this condition the held bed also pushes water that squeezes closer than `dp /
-//! sqrt(2)` to it away, with Monaghan's (1994) boundary force (`PairModel::add_contact`); water
-//! resting on the bed keeps about a dp from its particles and never feels it.
+//! this condition the held bed also pushes water that squeezes closer than 0.6 dp to it away,
+//! with Monaghan's (1994) boundary force (`PairModel::add_contact`, `CONTACT_REACH`); water
+//! resting on the bed keeps 0.7 dp or more from its particles and does not feel it.
 //!
 //! A wall particle with no fluid within 2h is dry: it takes rest density (p = 0), touching
 //! nothing that reads it. The fluid particles of an inlet buffer are left out of the sums:

@@ -402,11 +402,12 @@ pub fn molteni_case() -> Case {
 /// rates of tens per second, bed shear stresses on both sides of the Shields threshold, yielded
 /// and un-yielded sediment) with the lower three quarters of the bed at rest, so that the
 /// first rheology pass holds them and the release stage has held sand under moving sand to
-/// decide on.
+/// decide on. `prepare` may then change the particles before the simulation takes them.
 pub fn sediment_in_motion(
     backend: &Backend,
     c: &Case,
     seed: u64,
+    prepare: impl FnOnce(&mut flume_solver::Particles),
 ) -> (
     flume_solver::Simulation,
     flume_solver::Particles,
@@ -420,14 +421,15 @@ pub fn sediment_in_motion(
             particles.vel_rho[i][..3].fill(0.0);
         }
     }
+    prepare(&mut particles);
     let sim = flume_solver::Simulation::from_particles(backend.clone(), c, particles.clone())
         .expect("builds");
     let params = super::reference_params(&sim);
     (sim, particles, params)
 }
 
-/// A sand bed in motion ([`sediment_in_motion`]) before and after two steps of different
-/// lengths on `backend`, with the oracle's parameters and sediment model.
+/// A sand bed in motion ([`sediment_in_motion`], with `prepare`) before and after two steps of
+/// different lengths on `backend`, with the oracle's parameters and sediment model.
 pub struct TwoSteps {
     pub particles: flume_solver::Particles,
     pub params: flume_solver::physics::Params,
@@ -437,8 +439,13 @@ pub struct TwoSteps {
     pub dt2: f32,
 }
 
-pub fn two_steps_of_sand_in_motion(backend: &Backend, c: &Case, seed: u64) -> TwoSteps {
-    let (mut sim, particles, params) = sediment_in_motion(backend, c, seed);
+pub fn two_steps_of_sand_in_motion(
+    backend: &Backend,
+    c: &Case,
+    seed: u64,
+    prepare: impl FnOnce(&mut flume_solver::Particles),
+) -> TwoSteps {
+    let (mut sim, particles, params) = sediment_in_motion(backend, c, seed, prepare);
     let model = super::reference_sediment(&sim);
     let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
     sim.advance_to(f64::from(dt)).expect("step 1");
@@ -542,7 +549,7 @@ fn check_rheology_round(
 /// each particle's viscous limit. Two passes, the second starting from the holds of the first
 /// as a step starts from the last one's.
 pub fn check_rheology(backend: &Backend, c: Case, seed: u64) {
-    let (mut sim, particles, params) = sediment_in_motion(backend, &c, seed);
+    let (mut sim, particles, params) = sediment_in_motion(backend, &c, seed, |_| {});
     let model = super::reference_sediment(&sim);
     let mut held = vec![false; particles.len()];
     let (mut released, mut count) = (0, [0usize; 6]);
@@ -588,7 +595,7 @@ pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
         after,
         dt,
         dt2,
-    } = two_steps_of_sand_in_motion(backend, &c, 23);
+    } = two_steps_of_sand_in_motion(backend, &c, 23, |_| {});
 
     let n = particles.len();
     let forces = |pos: &[[f32; 4]], vel: &[[f32; 4]], held_before: &[bool]| {

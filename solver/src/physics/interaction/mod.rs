@@ -110,10 +110,22 @@ struct PhaseConsts {
     /// `rho0 g / B`, 1/m: the argument of the hydrostatic density difference per metre of
     /// height.
     hydro: f32,
-    /// `r0^2 = dp^2 / 2` of the contact force a wall of this phase exerts under the generalised
-    /// condition ([`PairModel::add_pair`]), m2; dp from the phase's particle volume.
+    /// `r0^2 = (CONTACT_REACH dp)^2` of the contact force a wall of this phase exerts under the
+    /// generalised condition ([`PairModel::add_pair`]), m2; dp from the phase's particle volume.
     contact2: f32,
 }
+
+/// Reach r0 of the held bed's contact force, in dp (`PairModel::add_contact`). Water passing
+/// between two neighbours of the bed's lattice comes within dp / 2 of both, so r0 must exceed
+/// dp / 2; the barrier it then raises between the two, `2 D [q^12 / 12 - q^4 / 4 + 1 / 6]` per
+/// unit mass with `q = 2 r0 / dp` and `D = u_max^2`, must stop water arriving at the fastest
+/// speed the case allows, `u_max = c0 / 10`, pushed down by a dp of its own weight: `u_max^2 /
+/// 2 + g dp`, 0.6 D at dp = 1 cm. That needs q >= 1.18; 0.6 dp (q = 1.2) gives 0.78 D. Every
+/// dp further reaches the water resting on the bed: at dp / sqrt(2) (the lattice's gaps, as
+/// first chosen) the water's first layer rode on it, 36 of the CI flume's water particles at
+/// 0.70-0.80 dp from held sand and none nearer, and the flat sand bed's levels stood 6 mm
+/// higher at P1 than without the force (README, levels section).
+pub const CONTACT_REACH: f32 = 0.6;
 
 /// Slots of the phase table; a power of two, the GPU uniform's `MAX_PHASES`.
 const PHASE_SLOTS: usize = 4;
@@ -183,7 +195,9 @@ impl<'a> PairModel<'a> {
                 mobile: ph.mobile,
                 b: tait_b(params.c0, ph.rho0),
                 hydro: ph.rho0 * -params.gravity[vertical] / tait_b(params.c0, ph.rho0),
-                contact2: 0.5 * (ph.mass / ph.rho0).powf(2.0 / params.dim as f32),
+                contact2: CONTACT_REACH
+                    * CONTACT_REACH
+                    * (ph.mass / ph.rho0).powf(2.0 / params.dim as f32),
             };
         }
         PairModel {
@@ -328,14 +342,14 @@ impl<'a> PairModel<'a> {
     }
 
     /// The contact force of held-bed particle `j` (a particle of a mobile phase standing as a
-    /// wall) on a particle of another phase closer than `r0 = dp / sqrt(2)`, under the
+    /// wall) on a particle of another phase closer than `r0` ([`CONTACT_REACH`] dp), under the
     /// generalised wall condition: Monaghan's (1994) boundary force, `D ((r0 / r)^12 - (r0 /
     /// r)^4) x_ij / r^2` per unit mass. A wall under that condition takes the pressure of the
     /// fluid around it, so water that got between two rows of the held bed (through a hole a
     /// pick-up left) feels its own pressure all round and travels through the bed to the floor
-    /// and out (`physics::boundary`). Water on the bed keeps about a dp from its particles, and
-    /// one in a gap of the lattice stands `dp / sqrt(2)` from four of them: the force acts only
-    /// on water squeezing between two. Not on the bed's own sand sliding over it, nor from the
+    /// and out (`physics::boundary`). Water on the bed keeps 0.7 dp or more from its particles,
+    /// and one in a gap of the lattice stands `dp / sqrt(2)` from four of them: the force acts
+    /// only on water squeezing between two. Not on the bed's own sand sliding over it, nor from the
     /// walls (both tried: the sand was shot off the bed by it at the jet's impact, and the
     /// inlet's corner blew up).
     #[inline(always)]

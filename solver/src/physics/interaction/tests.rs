@@ -304,12 +304,13 @@ fn three_d_uses_z_as_vertical() {
     assert_eq!(out.forces[0][..2], [0.0, 0.0]);
 }
 
-/// The held bed's contact force by hand: dp = 1 cm, c0 = 10 m/s, so D = 1 m2/s2 and r0^2 =
-/// dp^2 / 2 = 5e-5 m2 (the sand's particle volume is dp^2 too). A water particle 0.5 dp above
-/// a held sand particle standing as a wall, both at rest density (no pressure) and at rest:
-/// (r0 / r)^2 = 2, so the force is D (2^6 - 2^2) / r = 60 / 0.005 = 12 000 m/s2 straight up,
-/// under the generalised condition only; none at 0.75 dp (beyond r0 = 0.707 dp), none on sand
-/// of the bed's own phase, none from a wall.
+/// The held bed's contact force by hand: dp = 1 cm, c0 = 10 m/s, so D = 1 m2/s2 and r0 =
+/// 0.6 dp (the sand's particle volume is dp^2 too). A water particle 0.5 dp above a held sand
+/// particle standing as a wall, both at rest density (no pressure) and at rest: (r0 / r)^2 =
+/// 1.44, (r0 / r)^4 = 2.0736, (r0 / r)^12 = 8.916100, so the force is D 6.842500 / r =
+/// 6.842500 / 0.005 = 1368.50 m/s2 straight up, under the generalised condition only; none at
+/// 0.65 dp (beyond r0) nor in a gap of the lattice (dp / sqrt(2)), none on sand of the bed's
+/// own phase, none from a wall.
 #[test]
 fn held_bed_contact_force_by_hand() {
     let dp = 0.01;
@@ -337,8 +338,9 @@ fn held_bed_contact_force_by_hand() {
     params.generalised_walls = true;
     params.phases[WALL].generalised_wall = true;
     let a = up(&params, 0.5 * dp, (WATER, SAND));
-    assert!(close(a, 12_000.0, 1e-5), "{a}");
-    assert_eq!(up(&params, 0.75 * dp, (WATER, SAND)), 0.0);
+    assert!(close(a, 1368.5, 1e-5), "{a}");
+    assert_eq!(up(&params, 0.65 * dp, (WATER, SAND)), 0.0);
+    assert_eq!(up(&params, dp / 2.0_f32.sqrt(), (WATER, SAND)), 0.0);
     assert_eq!(
         up(&params, 0.5 * dp, (SAND, SAND)),
         0.0,
