@@ -78,17 +78,18 @@ pub fn run(flume: &Path, set: &[String], runs: &[LevelRun]) -> Result<()> {
 }
 
 /// The flume at `r`'s resolution and discharge, with a reservoir large enough for the water it
-/// stores, and its bed made wall when asked: the case file with overrides, validated as
-/// `--set` is. The reference is the sand bed's as generated at that dp, a fixed bed's too.
+/// stores unless `--set` sizes it, and its bed made wall when asked: the case file with
+/// overrides, validated as `--set` is. The reference is the sand bed's as generated at that
+/// dp, a fixed bed's too.
 fn level_case(flume: &Path, set: &[String], r: &LevelRun) -> Result<(Case, Channel)> {
-    let mut overrides = set.to_vec();
+    let mut overrides = vec![format!(
+        "open_flume.reservoir_particles={}",
+        (RESERVOIR_M2 / (r.dp_m * r.dp_m)).ceil()
+    )];
+    overrides.extend_from_slice(set);
     overrides.extend([
         format!("numerics.dp_m={}", r.dp_m),
         format!("open_flume.inflow_m3_per_s={}", r.m3_per_h / 3600.0),
-        format!(
-            "open_flume.reservoir_particles={}",
-            (RESERVOIR_M2 / (r.dp_m * r.dp_m)).ceil()
-        ),
         format!("time.end_s={}", r.until_s),
     ]);
     let sand = Case::from_path_with(flume, &overrides)
@@ -419,4 +420,35 @@ fn print_bed(sim: &Simulation, case: &Case, particles: &Particles, regions: &[u3
             .largest_gap_dp()
             .map_or("-".to_string(), |g| format!("{g:.2}"))
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reservoir is sized for the stored water unless `--set` sizes it; the resolution,
+    /// the discharge and the run's length are the benchmark's own.
+    #[test]
+    fn a_set_reservoir_is_kept() {
+        let flume =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+        let run = LevelRun {
+            dp_m: 0.01,
+            m3_per_h: 2.0,
+            until_s: 30.0,
+            fixed_bed: false,
+        };
+        let reservoir = |set: &[String]| {
+            let (case, _) = level_case(&flume, set, &run).expect("the CI flume");
+            assert_eq!(case.numerics.dp_m, 0.01);
+            assert_eq!(case.time.end_s, 30.0);
+            case.open_flume.expect("an open flume").reservoir_particles
+        };
+        // 0.3 m2 / (1 cm)^2.
+        assert_eq!(reservoir(&[]), 3000);
+        let set = ["open_flume.reservoir_particles=2500".to_string()];
+        assert_eq!(reservoir(&set), 2500);
+        let set = ["numerics.dp_m=0.02".to_string()];
+        assert_eq!(reservoir(&set), 3000, "--dp is the benchmark's");
+    }
 }
