@@ -146,10 +146,11 @@ pub fn check_symplectic_steps_with_held_bed_walls(backend: &Backend) {
 /// dp) in the checks, as water does that a pick-up's hole let into the bed. The lattice's
 /// perturbation alone brings water that close only by chance.
 fn water_against_the_bed(p: &mut flume_solver::Particles, c: &flume_solver::config::Case) {
-    const WATER: u32 = 1;
-    const SAND: u32 = 2;
+    let (sand_k, water_k) = c.sediment_phases().expect("a sand bed under water");
+    // Case phase k is the particles' phase k + 1 (0: walls).
+    let (sand_phase, water_phase) = (sand_k as u32 + 1, water_k as u32 + 1);
     let at_rest = |p: &flume_solver::Particles, i: usize| p.vel_rho[i][..3] == [0.0; 3];
-    let sand: Vec<usize> = (0..p.len()).filter(|&i| p.phase(i) == SAND).collect();
+    let sand: Vec<usize> = (0..p.len()).filter(|&i| p.phase(i) == sand_phase).collect();
     let gap = |i: usize, j: usize| {
         let (a, b) = (p.positions[i], p.positions[j]);
         (a[0] - b[0]).hypot(a[1] - b[1])
@@ -169,6 +170,6 @@ fn water_against_the_bed(p: &mut flume_solver::Particles, c: &flume_solver::conf
     for k in 0..2 {
         p.positions[i][k] = p.positions[j][k] + (p.positions[i][k] - p.positions[j][k]) * scale;
     }
-    p.positions[i][3] = f32::from_bits(WATER);
-    p.vel_rho[i] = [0.0, 0.0, 0.0, c.phases[0].rho0_kg_per_m3 as f32];
+    p.positions[i][3] = f32::from_bits(water_phase);
+    p.vel_rho[i] = [0.0, 0.0, 0.0, c.phases[water_k].rho0_kg_per_m3 as f32];
 }

@@ -347,9 +347,10 @@ impl<'a> PairModel<'a> {
     /// r)^4) x_ij / r^2` per unit mass. A wall under that condition takes the pressure of the
     /// fluid around it, so water that got between two rows of the held bed (through a hole a
     /// pick-up left) feels its own pressure all round and travels through the bed to the floor
-    /// and out (`physics::boundary`). Water on the bed keeps 0.7 dp or more from its particles,
-    /// and one in a gap of the lattice stands `dp / sqrt(2)` from four of them: the force acts
-    /// only on water squeezing between two. Not on the bed's own sand sliding over it, nor from the
+    /// and out (`physics::boundary`). Water on the bed mostly stands farther off than r0, and
+    /// one in a gap of the lattice stands `dp / sqrt(2)` from four of them: the force acts on
+    /// water squeezing between two, and lightly on the few pressed onto the bed (5 of the CI
+    /// flume's water particles at 0.5-0.6 dp at 30 s). Not on the bed's own sand sliding over it, nor from the
     /// walls (both tried: the sand was shot off the bed by it at the jet's impact, and the
     /// inlet's corner blew up).
     #[inline(always)]
