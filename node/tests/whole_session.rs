@@ -10,18 +10,20 @@ use std::process::Command;
 
 /// Last sample of the session, s after its first.
 const SESSION_S: f64 = 75.0;
-/// Each predicted level against the measured one from [`STEADY_FROM_S`] on, m: 2 dp. The
+/// Each predicted level against the measured one from [`STEADY_FROM_S`] on, m: 1.5 dp. The
 /// session's "measurements" are the 1-D reference of `flume_solver::hydraulics`; the CI-size
-/// twin stands 7-12 mm over them at P1-P3 (the eroded bed's holes and bumps a dp deep, README,
-/// levels section), 14.8 mm at worst. The case's own choices (DBC walls, alpha = 0.02, the
+/// twin stands 5-8 mm over them at P1-P3 (the grains the front leaves perched on the bed, README,
+/// levels section), 10.5 mm at worst. The case's own choices (DBC walls, alpha = 0.02, the
 /// release at once) stood 2-3 cm over and rose to the end, and fail it.
-const LEVEL_TOLERANCE_M: f64 = 0.02;
-/// RMS of each gauge's residual once the flume has filled ([`FILLED_FROM_S`]), m. Measured in
-/// two replays: 12.0 / 9.9 / 7.0 mm and 9.2 / 8.0 / 5.6 mm at P1 / P2 / P3 (the runs scatter by
-/// 3 mm); the bound is the larger plus that scatter, not the goal of 3 mm.
-const RMS_TOLERANCE_M: f64 = 0.015;
+const LEVEL_TOLERANCE_M: f64 = 0.015;
+/// RMS of each gauge's residual once the flume has filled ([`FILLED_FROM_S`]), m. Measured:
+/// 7.2 / 6.6 / 5.4 mm at P1 / P2 / P3; the bound is that plus the 3 mm by which replays
+/// scatter, not the goal of 3 mm. With the bed's slope taken from the water around a
+/// grain (which zeroed the critical stress under the front's thin sheet) it was 12.0 / 9.9 /
+/// 7.0 mm, and fails it.
+const RMS_TOLERANCE_M: f64 = 0.010;
 /// The residual's mean over the session's last 20 s against its mean over 20-40 s, m: the
-/// levels do not drift. Measured: 0.5 / 0.3 / 0.2 mm; a drift of 1 mm per 10 s, the levels
+/// levels do not drift. Measured: 1.0 / 1.2 / 1.4 mm; a drift of 1 mm per 10 s, the levels
 /// issue's goal, would move it by 3.5 mm.
 const DRIFT_TOLERANCE_M: f64 = 0.002;
 /// From when the levels are compared: the front passed P3 by 6 s at CI size, plus 4 s.

@@ -79,13 +79,16 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (!is_sediment) {
                 continue;
             }
+            // The bed's normal points away from the solid under it: sediment and walls.
+            if (phase_j == sd.phase || params.phases[phase_j].mobile < 0.5) {
+                normal -= v_j * gw;
+            }
             if (phase_j == sd.phase) {
                 sediment_volume += v_j;
                 mixture_volume += v_j;
                 kernel_mass += m_j * kernel_w(r) * v_j;
             } else if (phase_j == sd.water_phase) {
                 mixture_volume += v_j;
-                normal += v_j * gw;
                 if (r2 < nearest_r2) {
                     nearest_r2 = r2;
                     nearest_du = du;

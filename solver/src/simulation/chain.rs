@@ -22,7 +22,7 @@ impl Simulation {
             .filter(|&i| particles.phase(i) == sediment)
             .map(|i| {
                 let mut sums = pass.start(&pos[i], &vel[i]);
-                for j in (0..particles.len()).filter(|&j| j != i && !particles.is_wall(j)) {
+                for j in (0..particles.len()).filter(|&j| j != i) {
                     pass.add_pair((&pos[i], &vel[i]), (&pos[j], &vel[j]), &mut sums);
                 }
                 (i, pass.shields_chain(&sums))

@@ -1,0 +1,171 @@
+//! The slope factors, the bed's normal and the skeleton pressure, by hand.
+
+use super::*;
+
+use crate::physics::Phase;
+
+const DEG: f32 = std::f32::consts::PI / 180.0;
+
+#[test]
+fn flat_bed_has_unit_slope_factor() {
+    // Normal straight up: beta = gamma = 0, Eqs. 22-23 give sin(phi)/sin(phi) = 1 and
+    // cos(0) sqrt(1 - 0) = 1, whichever way the water flows.
+    for u in [[0.3, 0.0, 0.0], [-0.3, 0.0, 0.0]] {
+        assert_eq!(slope_factors([0.0, 1.0, 0.0], u, 2, 30.0 * DEG), 1.0);
+    }
+    assert_eq!(
+        slope_factors([0.0, 0.0, 2.0], [0.1, 0.2, 0.0], 3, 30.0 * DEG),
+        1.0
+    );
+}
+
+#[test]
+fn slope_factor_by_hand() {
+    // A 2-D bed sloping down towards +x at 10 deg: outward normal (sin 10, cos 10).
+    // Flow towards +x runs down the slope: sin(30 - 10) / sin 30 = 0.342020 / 0.5 = 0.684040.
+    // Flow towards -x runs up it: sin(40) / sin(30) = 0.642788 / 0.5 = 1.285575.
+    let n = [(10.0 * DEG).sin(), (10.0 * DEG).cos(), 0.0];
+    let down = slope_factors(n, [0.2, 0.0, 0.0], 2, 30.0 * DEG);
+    let up = slope_factors(n, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
+    assert!((down - 0.684_040).abs() < 1e-5, "{down}");
+    assert!((up - 1.285_575).abs() < 1e-5, "{up}");
+    // 3-D, the same tilt across a flow along y: gamma = 10 deg, beta = 0;
+    // cos 10 sqrt(1 - tan^2 10 / tan^2 30) = 0.984808 sqrt(1 - 0.031091 / 0.333333)
+    // = 0.984808 sqrt(0.906726) = 0.984808 * 0.952222 = 0.937755.
+    let n3 = [(10.0 * DEG).sin(), 0.0, (10.0 * DEG).cos()];
+    let across = slope_factors(n3, [0.0, 0.2, 0.0], 3, 30.0 * DEG);
+    assert!((across - 0.937_755).abs() < 1e-5, "{across}");
+}
+
+/// The case's sand (d50 0.4 mm, 2710 kg/m3, phi 32 deg) in the Shields-only mode, at
+/// dp = 1 cm with h = 1.7 dp: phases wall, water, sand.
+fn flume_sand() -> (Params, SedimentModel) {
+    let dp = 0.01;
+    let phase = |rho0: f32, mobile: bool| Phase {
+        rho0,
+        mass: rho0 * dp * dp,
+        mu: 1e-3,
+        mobile,
+        generalised_wall: false,
+    };
+    let params = Params {
+        dim: 2,
+        h: 1.7 * dp,
+        c0: 10.0,
+        gravity: [0.0, -9.81, 0.0],
+        hydrostatic_diffusion: true,
+        delta: 0.1,
+        viscosity: Viscosity::Multiphase {
+            alpha: 0.0,
+            sps_length2: 0.0,
+        },
+        clamp_negative_pressure: false,
+        generalised_walls: true,
+        cfl: 0.2,
+        phases: vec![
+            phase(1000.0, false),
+            phase(1000.0, true),
+            phase(2710.0, true),
+        ],
+    };
+    let model = SedimentModel {
+        material: SedimentParams {
+            rho_s: 2710.0,
+            d50_m: 4e-4,
+            phi_rad: 32.0 * DEG,
+            cohesion_pa: 0.0,
+            hbp_m: 0.0,
+            hbp_n: 1.0,
+            mu_s_pa_s: 1e-3,
+            ks_over_d50: 3.0,
+            surface_mass_fraction: 0.8,
+            rho_w: 1000.0,
+            nu_w: 1e-6,
+            mu_w: 1e-3,
+        },
+        sediment_phase: 2,
+        water_phase: 1,
+        shields_only: true,
+        mu_max: 50.0,
+        pickup_per_s: 0.0,
+    };
+    (params, model)
+}
+
+/// The Shields chain of the particle at the origin, the top of a flat bed of 13 x 5
+/// particles at rest whose columns `x < 0` are of `left_phase`, under `water` (positions,
+/// moving at 0.5 m/s along +x).
+fn chain_on_flat_bed(left_phase: u32, water: &[[f32; 2]]) -> ShieldsChain {
+    let (params, model) = flume_sand();
+    let pass = Rheology::new(&params, &model);
+    let dp = 0.01;
+    let at = |x: f32, y: f32, phase: u32| [x, y, 0.0, f32::from_bits(phase)];
+    let mut pos: Vec<[f32; 4]> = Vec::new();
+    let mut vel: Vec<[f32; 4]> = Vec::new();
+    for row in 0..5 {
+        for col in -6..=6 {
+            let phase = if col < 0 { left_phase } else { 2 };
+            pos.push(at(col as f32 * dp, -(row as f32) * dp, phase));
+            vel.push([0.0, 0.0, 0.0, params.phases[phase as usize].rho0]);
+        }
+    }
+    for w in water {
+        pos.push(at(w[0], w[1], 1));
+        vel.push([0.5, 0.0, 0.0, 1000.0]);
+    }
+    let i = pos.iter().position(|p| p[0] == 0.0 && p[1] == 0.0);
+    let i = i.expect("the bed's top at the origin");
+    let mut s = pass.start(&pos[i], &vel[i]);
+    for j in 0..pos.len() {
+        pass.add_pair((&pos[i], &vel[i]), (&pos[j], &vel[j]), &mut s);
+    }
+    pass.shields_chain(&s)
+}
+
+/// The critical stress on a flat bed for the chain's friction velocity, Pa.
+fn flat_critical_stress(chain: &ShieldsChain) -> f32 {
+    let (_, model) = flume_sand();
+    let m = &model.material;
+    let theta = critical_shields(chain.u_star_m_per_s * m.d50_m / m.nu_w);
+    critical_bed_shear_stress(theta, m.rho_s, m.rho_w, 9.81, m.d50_m)
+}
+
+#[test]
+fn a_flat_bed_under_water_on_one_side_is_flat() {
+    // The tip of a sheet one particle thick: water over the bed only downstream of the
+    // grain. Its slope is the bed's (flat), not the water's: a normal taken from the
+    // water leans 45 deg downstream, past the friction angle, and gives tau_bcr = 0.
+    let dp = 0.01;
+    let sheet = [[dp, dp], [2.0 * dp, dp], [3.0 * dp, dp]];
+    let chain = chain_on_flat_bed(2, &sheet);
+    assert!(chain.at_surface && chain.u_star_m_per_s > 0.0, "{chain:?}");
+    let flat = flat_critical_stress(&chain);
+    assert!(
+        (chain.tau_bcr_pa - flat).abs() < 1e-4 * flat,
+        "{} Pa against the flat bed's {flat} Pa",
+        chain.tau_bcr_pa
+    );
+}
+
+#[test]
+fn a_wall_level_with_the_bed_is_bed() {
+    // The sand's first column beside the apron: the wall upstream at the same level is as
+    // solid as sand. Counting sand alone, the normal would lean 20-odd deg upstream.
+    let dp = 0.01;
+    let water = [[-dp, dp], [0.0, dp], [dp, dp]];
+    let chain = chain_on_flat_bed(0, &water);
+    let flat = flat_critical_stress(&chain);
+    assert!(
+        (chain.tau_bcr_pa - flat).abs() < 1e-4 * flat,
+        "{} Pa against the flat bed's {flat} Pa",
+        chain.tau_bcr_pa
+    );
+}
+
+#[test]
+fn skeleton_pressure_is_effective_stress_at_the_surface() {
+    // 5 cm below a bed surface that is the free surface: p = rho_s g d = 2710 * 9.81 * 0.05
+    // = 1329.255 Pa; effective stress (rho_s - rho_w) g d = 1710 * 9.81 * 0.05 = 838.755 Pa.
+    let p = skeleton_pressure(1329.255, 2710.0, 1000.0);
+    assert!((p - 838.755).abs() < 1e-2, "{p}");
+}
