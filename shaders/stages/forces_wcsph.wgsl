@@ -35,12 +35,16 @@ fn stress_over_rho2(i: u32, rho: f32) -> mat3x3<f32> {
     return mat3x3<f32>(a.xyz, vec3<f32>(a.y, a.w, b.x), vec3<f32>(a.z, b.x, b.y)) * (1.0 / (rho * rho));
 }
 
-// r0^2 = (0.6 dp)^2 of the held bed's contact force, dp from the sand's particle volume
-// (`CONTACT_REACH` and `PhaseConsts::contact2` in interaction/mod.rs).
+// The held bed's contact force reaches CONTACT_REACH dp (`CONTACT_REACH` in interaction/mod.rs).
+const CONTACT_REACH: f32 = 0.6;
+
+// r0^2 = (CONTACT_REACH dp)^2, dp from the sand's particle volume (`PhaseConsts::contact2` in
+// interaction/mod.rs).
 fn bed_contact_r0_2() -> f32 {
     let sand = params.phases[params.sediment.phase];
     let v0 = sand.mass / sand.rho0;
-    return 0.36 * select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
+    let dp2 = select(pow(v0, 2.0 / 3.0), v0, params.vertical_axis == 1u);
+    return CONTACT_REACH * CONTACT_REACH * dp2;
 }
 
 // The contact force per unit mass of a held-bed particle on a particle of another phase r2

@@ -169,6 +169,11 @@ fn every_constant_stated_on_both_sides_agrees() {
         ),
         ("dt_update", "STATUS_DT_COLLAPSE", U32(Health::DT_COLLAPSE)),
         ("yield_release", "FLOW_ONSET", F32(hold::FLOW_ONSET)),
+        (
+            "forces_wcsph",
+            "CONTACT_REACH",
+            F32(flume_solver::physics::interaction::CONTACT_REACH),
+        ),
         ("rheology", "KARMAN", F32(shields::KARMAN)),
         (
             "rheology",
