@@ -5,8 +5,8 @@
 
 use super::grid::Grid;
 use crate::contract::SimParams;
-use crate::physics::sediment::SedimentParams;
 use crate::physics::sediment::pass::SedimentModel;
+use crate::physics::sediment::{SedimentParams, flume_sand};
 use crate::physics::{Params, Phase, Viscosity};
 use bytemuck::Zeroable;
 
@@ -63,18 +63,8 @@ fn params(viscosity: Viscosity) -> Params {
 fn sediment() -> SedimentModel {
     SedimentModel {
         material: SedimentParams {
-            rho_s: 2710.0,
-            d50_m: 4e-4,
             phi_rad: 0.6,
-            cohesion_pa: 0.0,
-            hbp_m: 0.0,
-            hbp_n: 1.0,
-            mu_s_pa_s: 1e-3,
-            ks_over_d50: 3.0,
-            surface_mass_fraction: 0.8,
-            rho_w: 1000.0,
-            nu_w: 1e-6,
-            mu_w: 1e-3,
+            ..flume_sand()
         },
         sediment_phase: SAND as usize,
         water_phase: WATER as usize,

@@ -72,3 +72,23 @@ impl SedimentParams {
         self.ks_over_d50 * self.d50_m
     }
 }
+
+/// The ULBRA flume's sand (d50 0.4 mm, 2710 kg/m3, ks = 3 d50, HBP n = 1, m = 0) in water at
+/// 20 C, with a friction angle of 32 deg: the sand the unit tests of both engines use.
+#[cfg(test)]
+pub(crate) fn flume_sand() -> SedimentParams {
+    SedimentParams {
+        rho_s: 2710.0,
+        d50_m: 4e-4,
+        phi_rad: 32f32.to_radians(),
+        cohesion_pa: 0.0,
+        hbp_m: 0.0,
+        hbp_n: 1.0,
+        mu_s_pa_s: 1e-3,
+        ks_over_d50: 3.0,
+        surface_mass_fraction: 0.8,
+        rho_w: 1000.0,
+        nu_w: 1e-6,
+        mu_w: 1e-3,
+    }
+}

@@ -39,7 +39,7 @@ fn slope_factor_by_hand() {
 
 /// The case's sand (d50 0.4 mm, 2710 kg/m3, phi 32 deg) in the Shields-only mode, at
 /// dp = 1 cm with h = 1.7 dp: phases wall, water, sand.
-fn flume_sand() -> (Params, SedimentModel) {
+fn flume_case() -> (Params, SedimentModel) {
     let dp = 0.01;
     let phase = |rho0: f32, mobile: bool| Phase {
         rho0,
@@ -69,20 +69,7 @@ fn flume_sand() -> (Params, SedimentModel) {
         ],
     };
     let model = SedimentModel {
-        material: SedimentParams {
-            rho_s: 2710.0,
-            d50_m: 4e-4,
-            phi_rad: 32.0 * DEG,
-            cohesion_pa: 0.0,
-            hbp_m: 0.0,
-            hbp_n: 1.0,
-            mu_s_pa_s: 1e-3,
-            ks_over_d50: 3.0,
-            surface_mass_fraction: 0.8,
-            rho_w: 1000.0,
-            nu_w: 1e-6,
-            mu_w: 1e-3,
-        },
+        material: crate::physics::sediment::flume_sand(),
         sediment_phase: 2,
         water_phase: 1,
         shields_only: true,
@@ -96,7 +83,7 @@ fn flume_sand() -> (Params, SedimentModel) {
 /// particles at rest whose columns `x < 0` are of `left_phase`, under `water` (positions,
 /// moving at 0.5 m/s along +x).
 fn chain_on_flat_bed(left_phase: u32, water: &[[f32; 2]]) -> ShieldsChain {
-    let (params, model) = flume_sand();
+    let (params, model) = flume_case();
     let pass = Rheology::new(&params, &model);
     let dp = 0.01;
     let at = |x: f32, y: f32, phase: u32| [x, y, 0.0, f32::from_bits(phase)];
@@ -122,12 +109,16 @@ fn chain_on_flat_bed(left_phase: u32, water: &[[f32; 2]]) -> ShieldsChain {
     pass.shields_chain(&s)
 }
 
-/// The critical stress on a flat bed for the chain's friction velocity, Pa.
-fn flat_critical_stress(chain: &ShieldsChain) -> f32 {
-    let (_, model) = flume_sand();
-    let m = &model.material;
+/// The chain's critical stress is a flat bed's for its friction velocity (slope factor 1).
+fn assert_flat_critical_stress(chain: &ShieldsChain) {
+    let m = crate::physics::sediment::flume_sand();
     let theta = critical_shields(chain.u_star_m_per_s * m.d50_m / m.nu_w);
-    critical_bed_shear_stress(theta, m.rho_s, m.rho_w, 9.81, m.d50_m)
+    let flat = critical_bed_shear_stress(theta, m.rho_s, m.rho_w, 9.81, m.d50_m);
+    assert!(
+        (chain.tau_bcr_pa - flat).abs() < 1e-4 * flat,
+        "{} Pa against the flat bed's {flat} Pa",
+        chain.tau_bcr_pa
+    );
 }
 
 #[test]
@@ -139,12 +130,7 @@ fn a_flat_bed_under_water_on_one_side_is_flat() {
     let sheet = [[dp, dp], [2.0 * dp, dp], [3.0 * dp, dp]];
     let chain = chain_on_flat_bed(2, &sheet);
     assert!(chain.at_surface && chain.u_star_m_per_s > 0.0, "{chain:?}");
-    let flat = flat_critical_stress(&chain);
-    assert!(
-        (chain.tau_bcr_pa - flat).abs() < 1e-4 * flat,
-        "{} Pa against the flat bed's {flat} Pa",
-        chain.tau_bcr_pa
-    );
+    assert_flat_critical_stress(&chain);
 }
 
 #[test]
@@ -154,12 +140,7 @@ fn a_wall_level_with_the_bed_is_bed() {
     let dp = 0.01;
     let water = [[-dp, dp], [0.0, dp], [dp, dp]];
     let chain = chain_on_flat_bed(0, &water);
-    let flat = flat_critical_stress(&chain);
-    assert!(
-        (chain.tau_bcr_pa - flat).abs() < 1e-4 * flat,
-        "{} Pa against the flat bed's {flat} Pa",
-        chain.tau_bcr_pa
-    );
+    assert_flat_critical_stress(&chain);
 }
 
 #[test]
