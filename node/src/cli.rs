@@ -352,7 +352,18 @@ pub struct BenchArgs {
     /// With --levels: the sand bed replaced by a fixed wall block of its shape (clear water).
     #[arg(long, requires = "levels")]
     pub fixed_bed: bool,
-    /// With --levels: override a field of the flume case (repeatable), as `simulate --set`.
-    #[arg(long = "set", value_name = "KEY=VALUE", requires = "levels")]
+    /// Override a field of the flume case (repeatable), as `simulate --set`: of the timed
+    /// flume, or with --levels of the flume run to a steady state.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Run the timed flume to this flume time before timing it, s (the CI-size twin has filled
+    /// by 20 s); 0: from the dry start.
+    #[arg(
+        long,
+        value_name = "T_S",
+        default_value_t = 0.0,
+        conflicts_with = "levels",
+        allow_negative_numbers = true
+    )]
+    pub from: f64,
 }

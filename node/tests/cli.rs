@@ -115,6 +115,38 @@ fn bench_levels_refuses_bad_flags_before_it_runs() {
     }
 }
 
+/// The timing `bench` refuses a start time that is no flume time and a value the flume case
+/// refuses, saying which, before any measurement starts.
+#[test]
+fn bench_refuses_bad_flags_before_it_times() {
+    let cases: [(&[&str], &str); 2] = [
+        (&["--from", "-1"], "--from: -1 s"),
+        (&["--set", "numerics.cfl=-1"], "numerics.cfl"),
+    ];
+    for (args, want) in cases {
+        let (case, flume) = (
+            repo_file("launch_configs/dsph_dambreak_val2d.yaml"),
+            repo_file("launch_configs/ulbra_flume.yaml"),
+        );
+        let mut all = vec!["bench", "--ladder", "4000", "--steps-seconds", "0.1"];
+        all.extend([
+            "--case",
+            case.to_str().unwrap(),
+            "--flume",
+            flume.to_str().unwrap(),
+        ]);
+        all.extend(args);
+        let out = flume_twin(&all);
+        let stderr = text(&out.stderr);
+        assert!(!out.status.success(), "{all:?} ran");
+        assert!(stderr.contains(want), "{all:?}: {stderr}");
+        assert!(
+            !text(&out.stdout).contains("particle-steps"),
+            "{all:?} timed something"
+        );
+    }
+}
+
 #[test]
 fn missing_case_file_is_reported() {
     let dir = scratch("missing_case");

@@ -13,8 +13,10 @@ pub const CPU_BACKEND: &str = "cpu";
 pub enum Backend {
     /// The wgpu backend on this adapter.
     Gpu(Arc<GpuContext>),
-    /// The native CPU backend on this many threads (0: one per core).
-    Cpu { threads: usize },
+    /// The native CPU backend on this many threads (0: one per core); with `awake_set`,
+    /// walls and held grains far from moving fluid skip their neighbour loops, which gives the
+    /// same bits (`cpu/forces.rs`): false is the full computation it is checked against.
+    Cpu { threads: usize, awake_set: bool },
 }
 
 impl From<Arc<GpuContext>> for Backend {
@@ -36,12 +38,20 @@ impl std::fmt::Debug for Backend {
 }
 
 impl Backend {
+    /// The CPU backend on `threads` threads (0: one per core), with its awake set.
+    pub const fn cpu(threads: usize) -> Backend {
+        Backend::Cpu {
+            threads,
+            awake_set: true,
+        }
+    }
+
     /// The backend `FLUME_TWIN_ADAPTER` names, else a real (not software) GPU, else the CPU
     /// backend (faster than a software adapter on the same cores).
     pub fn choose() -> Result<Backend, GpuError> {
         let wanted = std::env::var(ADAPTER_ENV).ok().filter(|s| !s.is_empty());
         match wanted.as_deref() {
-            Some(w) if w.eq_ignore_ascii_case(CPU_BACKEND) => Ok(Backend::Cpu { threads: 0 }),
+            Some(w) if w.eq_ignore_ascii_case(CPU_BACKEND) => Ok(Backend::cpu(0)),
             Some(w) => Ok(Backend::Gpu(Arc::new(GpuContext::with_adapter(Some(w))?))),
             None => Ok(Self::best()),
         }
@@ -50,7 +60,7 @@ impl Backend {
     fn best() -> Backend {
         match GpuContext::with_adapter(None) {
             Ok(g) if !g.is_software() => Backend::Gpu(Arc::new(g)),
-            _ => Backend::Cpu { threads: 0 },
+            _ => Backend::cpu(0),
         }
     }
 
@@ -58,7 +68,7 @@ impl Backend {
     pub fn describe(&self) -> String {
         match self {
             Backend::Gpu(g) => format!("wgpu on {}", g.adapter),
-            Backend::Cpu { threads } => crate::cpu::describe(*threads),
+            Backend::Cpu { threads, awake_set } => crate::cpu::describe(*threads, *awake_set),
         }
     }
 }

@@ -51,11 +51,15 @@ pub fn inlet_scan(
     }
 }
 
-/// Time spent in one stage, summed over the steps since the engine was built.
+/// Time spent in one stage, summed over the steps since the engine was built, and the
+/// particles its neighbour passes took (zero for a stage without one), of which `asleep` were
+/// spared their neighbour loop.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StageTime {
     pub stage: &'static str,
     pub seconds: f64,
+    pub particles: u64,
+    pub asleep: u64,
 }
 
 pub trait Engine: Send {

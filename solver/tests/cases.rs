@@ -6,7 +6,7 @@ mod common;
 use flume_solver::Particles;
 use flume_solver::{Backend, Case, Simulation};
 
-const CPU: Backend = Backend::Cpu { threads: 2 };
+const CPU: Backend = Backend::cpu(2);
 
 /// Runs `check` on the CPU backend, then on the GPU when there is one (one GPU test at a
 /// time): what it returns from each, CPU first.
@@ -336,7 +336,7 @@ fn dambreak_is_bit_identical_run_to_run_and_loses_nothing() {
 /// thread in sorted order, whatever the number of threads.
 #[test]
 fn dambreak_on_the_cpu_is_bit_identical_run_to_run_and_on_any_thread_count() {
-    assert_same_bits(&[CPU, CPU, Backend::Cpu { threads: 1 }]);
+    assert_same_bits(&[CPU, CPU, Backend::cpu(1)]);
 }
 
 /// Runs the dam break at dp = 5 mm to 0.04 s on each backend: every run gives the same bits,

@@ -7,7 +7,7 @@ use common::parked;
 use common::stages::{self, case};
 use flume_solver::Backend;
 
-const CPU: Backend = Backend::Cpu { threads: 2 };
+const CPU: Backend = Backend::cpu(2);
 
 #[test]
 fn cell_list_matches_a_counting_sort_exactly() {

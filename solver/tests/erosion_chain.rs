@@ -285,7 +285,7 @@ fn clear_region(g: &Grain) -> Option<Region> {
 fn the_erosion_chain_of_the_flowing_flumes_grains_matches_the_oracle() {
     let case = ulbra_ci();
     let oracle = Oracle::new(&case);
-    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    let mut sim = Simulation::new(Backend::cpu(0), &case).expect("builds");
     for t in [5.0, 15.0] {
         sim.advance_to(t).expect("runs");
         let particles = sim.read_particles().expect("readback");

@@ -21,7 +21,7 @@ fn set(sim: &mut Simulation, q: f64) {
 #[test]
 fn a_schedule_applies_each_discharge_at_its_time_and_a_refused_one_changes_nothing() {
     let c = common::ulbra_ci();
-    let backend = Backend::Cpu { threads: 0 };
+    let backend = Backend::cpu(0);
     let limit = inflow_limit_m3_per_s(&c).expect("an open flume");
     let (q1, q2) = (1.0 / 3600.0, 3.0 / 3600.0);
     let schedule = InflowSchedule::new(vec![(0.02, q1), (0.04, 2.0 * limit), (0.06, q2)]);

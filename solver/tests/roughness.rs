@@ -111,7 +111,7 @@ struct Run {
 fn run(ks_over_d50: f64) -> Run {
     let case = short_flume(ks_over_d50);
     let sand_phase = case.sediment_phases().expect("sand").0 as u32 + 1;
-    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    let mut sim = Simulation::new(Backend::cpu(0), &case).expect("builds");
     let initial = sim.read_particles().expect("reads");
     let mut books = SedimentBudget::new(&case, &initial).expect("a flume with sand");
     sim.advance_to(END_S).expect("runs");

@@ -92,7 +92,7 @@ fn check_clear_water(m3_per_h: f64) {
     let flume = case.open_flume.as_ref().expect("flume");
     let (q, width) = (flume.inflow_m3_per_s, flume.width_m);
     let reference = channel.steady(q, width);
-    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    let mut sim = Simulation::new(Backend::cpu(0), &case).expect("builds");
     sim.advance_to(20.0).expect("fills");
     let before = mean_levels(&mut sim, 21, 30);
     let books = |sim: &Simulation| {
@@ -160,7 +160,7 @@ fn the_weir_passes_its_discharge_at_rehbocks_head_over_a_still_pool() {
     let dp = case.numerics.dp_m;
     let flume = case.open_flume.as_ref().expect("an open flume");
     let q = flume.inflow_m3_per_s / flume.width_m;
-    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    let mut sim = Simulation::new(Backend::cpu(0), &case).expect("builds");
     let weir = weir_as_generated(sim.initial_particles(), dp, case.walls.layers);
     let want = weir.crest_m + weir.sharp_head_m(q);
     let gauge = case
@@ -239,7 +239,7 @@ fn the_cpu_and_wgpu_backends_agree_on_the_clear_water_flume() {
             .count();
         (levels, through)
     };
-    let (cpu, cpu_through) = run(Backend::Cpu { threads: 0 });
+    let (cpu, cpu_through) = run(Backend::cpu(0));
     let (wgpu, wgpu_through) = run(Backend::from(gpu));
     assert_eq!((cpu_through, wgpu_through), (0, 0), "water through a wall");
     assert!(cpu[3].is_some(), "P1 dry at 4 s");
@@ -270,7 +270,7 @@ fn a_still_tank_three_particles_deep_reads_its_true_level() {
         ];
         let case = Case::from_path_with(&case_path("tests/cases/hydrostatic_2d.yaml"), &set)
             .expect("the still tank");
-        let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+        let mut sim = Simulation::new(Backend::cpu(0), &case).expect("builds");
         let filled = filled_level(sim.initial_particles(), case.numerics.dp_m);
         let mut levels = Vec::new();
         for k in 1..=10 {
@@ -348,7 +348,7 @@ fn the_held_sand_carries_the_water_above_it() {
         "phases.1.sediment.erosion=van_rijn_pickup".to_string(),
     ];
     let case = Case::from_path_with(&path, &set).expect("the CI flume");
-    let mut sim = Simulation::new(Backend::Cpu { threads: 0 }, &case).expect("builds");
+    let mut sim = Simulation::new(Backend::cpu(0), &case).expect("builds");
     for t in [40.0, 50.0] {
         sim.advance_to(t).expect("runs");
         let particles = sim.read_particles().expect("readback");

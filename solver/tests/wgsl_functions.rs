@@ -66,7 +66,7 @@ fn probe() -> Option<Probe> {
             sediment.erosion = Erosion::VanRijnPickup;
         }
     }
-    let sim = Simulation::new(Backend::Cpu { threads: 1 }, &case).expect("the case runs");
+    let sim = Simulation::new(Backend::cpu(1), &case).expect("the case runs");
     Some(Probe {
         gpu,
         uniform: *sim.params(),

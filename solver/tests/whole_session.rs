@@ -158,7 +158,7 @@ fn run(backend: Backend, end_s: u32) -> (Vec<Second>, f64) {
     (seconds, wall)
 }
 
-const CPU: Backend = Backend::Cpu { threads: 0 };
+const CPU: Backend = Backend::cpu(0);
 
 /// The bundled session's steady levels at 2 m3/h (`tests/data/ulbra_session.mcap`, made by
 /// `flume-twin make-session` from the 1-D reference of `flume_solver::hydraulics`: the weir's

@@ -85,7 +85,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // Load the cases first so a wrong path fails before minutes of timing.
     let reference = Case::from_path(&args.case)
         .context("cannot load the reference case (run from the repository root or pass --case)")?;
-    let flume = Case::from_path(&args.flume)
+    if !(args.from.is_finite() && args.from >= 0.0) {
+        bail!("--from: {} s is not a flume time", args.from);
+    }
+    let flume = Case::from_path_with(&args.flume, &args.set)
         .context("cannot load the flume case (run from the repository root or pass --flume)")?;
     let backends = backends()?;
     for b in &backends {
@@ -137,15 +140,21 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     print_reference(&measured, &reference);
     println!();
+    let start = if args.from > 0.0 {
+        format!("from t = {} s", args.from)
+    } else {
+        "from the dry start".to_string()
+    };
     println!(
-        "open flume {} ({}), dp = {} m, from the dry start with the inlet running;\n\
-         particle-steps count the particles in the flow (not the parked ones)",
+        "open flume {} ({}), dp = {} m, {start} with the inlet running;\n\
+         particle-steps count the particles in the flow (not the parked ones); the CPU \
+         backend also without its awake set",
         flume.name,
         args.flume.display(),
         flume.numerics.dp_m
     );
-    for b in &backends {
-        match measure(b, &flume, args.steps_seconds) {
+    for b in with_full_cpu(&backends) {
+        match measure_from(&b, &flume, args.from, args.steps_seconds) {
             Ok(m) => {
                 let mut table = throughput_table();
                 throughput_row(&mut table, &m);
@@ -178,13 +187,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 fn backends() -> Result<Vec<Backend>> {
     let wanted = std::env::var(flume_solver::ADAPTER_ENV).unwrap_or_default();
     if wanted.eq_ignore_ascii_case(flume_solver::CPU_BACKEND) {
-        return Ok(vec![Backend::Cpu { threads: 0 }]);
+        return Ok(vec![Backend::cpu(0)]);
     }
     if !wanted.is_empty() {
         let gpu = GpuContext::new().context("cannot open the adapter FLUME_TWIN_ADAPTER names")?;
         return Ok(vec![Backend::from(Arc::new(gpu))]);
     }
-    let mut out = vec![Backend::Cpu { threads: 0 }];
+    let mut out = vec![Backend::cpu(0)];
     match GpuContext::new() {
         Ok(gpu) => out.push(Backend::from(Arc::new(gpu))),
         Err(e) => println!("no wgpu adapter: {e}"),
@@ -239,6 +248,21 @@ fn print_stages(m: &Measurement) {
         .map(|s| format!("{} {:.1} %", s.stage, 100.0 * s.seconds / m.wall_s))
         .collect();
     println!("  stages on {}: {}", m.backend, parts.join(", "));
+    let awake: Vec<String> = m
+        .stages
+        .iter()
+        .filter(|s| s.particles > 0)
+        .map(|s| {
+            let share = 1.0 - s.asleep as f64 / s.particles as f64;
+            format!("{} {:.1} %", s.stage, 100.0 * share)
+        })
+        .collect();
+    if !awake.is_empty() {
+        println!(
+            "  awake (particles that walked their neighbours): {}",
+            awake.join(", ")
+        );
+    }
 }
 
 fn throughput_table() -> Table {
@@ -302,14 +326,42 @@ time: {{ end_s: 10.0, output_interval_s: 0.01 }}
         .with_context(|| format!("the synthetic case for {fluid} particles is invalid"))
 }
 
+/// `backends` with, after each CPU backend, the same computing every particle in full (the
+/// awake set's reference).
+fn with_full_cpu(backends: &[Backend]) -> Vec<Backend> {
+    let mut out = Vec::new();
+    for b in backends {
+        out.push(b.clone());
+        if let Backend::Cpu { threads, .. } = *b {
+            out.push(Backend::Cpu {
+                threads,
+                awake_set: false,
+            });
+        }
+    }
+    out
+}
+
 /// Times `case` on `backend` for about `wall_target_s` after a warm-up.
 fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measurement> {
+    measure_from(backend, case, 0.0, wall_target_s)
+}
+
+/// [`measure`] from flume time `from_s`.
+fn measure_from(
+    backend: &Backend,
+    case: &Case,
+    from_s: f64,
+    wall_target_s: f64,
+) -> Result<Measurement> {
     let name = &case.name;
     let mut sim =
         Simulation::new(backend.clone(), case).with_context(|| format!("cannot set up {name}"))?;
+    sim.advance_to(from_s)
+        .with_context(|| format!("{name}: failed before t = {from_s} s"))?;
     // The real step is never larger, so the warm-up is at least 4 steps.
     let dt_guess = sim.acoustic_dt_bound_s();
-    sim.advance_to(4.0 * dt_guess)
+    sim.advance_to(from_s + 4.0 * dt_guess)
         .with_context(|| format!("{name}: warm-up failed"))?;
 
     let min_stretch_s = |sim: &Simulation| MIN_STRETCH_STEPS * sim.last_dt_s().max(dt_guess);
@@ -351,6 +403,8 @@ fn measure(backend: &Backend, case: &Case, wall_target_s: f64) -> Result<Measure
         .map(|(now, before)| StageTime {
             stage: now.stage,
             seconds: now.seconds - before.seconds,
+            particles: now.particles - before.particles,
+            asleep: now.asleep - before.asleep,
         })
         .collect();
     Ok(Measurement {

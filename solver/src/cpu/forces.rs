@@ -4,12 +4,21 @@
 //! to [`LANES`] particles of one row of cells, each neighbour against the whole group at once
 //! (`physics::lanes`); every lane sums its own neighbours in sorted order, as one particle
 //! alone would, so the result does not depend on the grouping or on the number of threads.
+//!
+//! The awake set: a wall (or held sand standing as one) takes no acceleration, so its only
+//! output is its density. Under the generalised condition that comes from its wall sums over
+//! the fluid (`physics::boundary`), and its pair sums are not computed. Under DBC its rate
+//! sums the mobile particles alone (`PairModel::add_pair`): with none in the cells within
+//! reach it is exactly zero, and the wall is not visited. A dry wall under the generalised
+//! condition takes rest density without a neighbour loop. Each of these is the value the full
+//! sums give, to the bit (`cpu_awake_set` in the solver's tests); nothing a mobile particle
+//! reads is skipped, since every mobile particle runs its own sums.
 
-use super::grid::{Grid, Group};
+use super::grid::{Flagged, Grid, Group};
 use super::simd;
 use crate::physics::boundary::WallSums;
 use crate::physics::interaction::{PairModel, PairSum, Side};
-use crate::physics::lanes::{Lanes, Real};
+use crate::physics::lanes::{LANES, Lanes, Real};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
 use rayon::prelude::*;
@@ -27,6 +36,9 @@ pub struct Extra<'a> {
     /// Particles whose velocity is imposed (an open flume's inlet buffer and duct): their
     /// acceleration does not bound the step. Empty: none.
     pub imposed: &'a [bool],
+    /// The mobile particles, whose presence within reach wakes a wall; None: every wall runs
+    /// its full sums (the full computation the awake set is checked against).
+    pub mobile: Option<&'a Flagged>,
 }
 
 /// What one block of the pass reads.
@@ -39,7 +51,8 @@ struct Pass<'a> {
 
 /// Fills `forces` (`[ax, ay, az, d rho/dt]`) and `dt_limit` (the stable step before the CFL
 /// factor) of each particle of `sides`, in sorted order; cells come from `grid`, whose
-/// starts were sorted from the same particles or from the state half a step before.
+/// starts were sorted from the same particles or from the state half a step before. Returns
+/// how many walls were spared the walk over their neighbours (see the module doc).
 pub fn force_pass(
     pool: &rayon::ThreadPool,
     model: &PairModel,
@@ -48,7 +61,7 @@ pub fn force_pass(
     extra: &Extra,
     forces: &mut [[f32; 4]],
     dt_limit: &mut [f32],
-) {
+) -> usize {
     let pass = Pass {
         model,
         grid,
@@ -60,32 +73,63 @@ pub fn force_pass(
             .par_chunks_mut(BLOCK)
             .zip(dt_limit.par_chunks_mut(BLOCK))
             .enumerate()
-            .for_each(|(block, (forces, dt_limit))| {
-                simd::dispatch(|| pass.block(block * BLOCK, forces, dt_limit));
-            });
-    });
+            .map(|(block, (forces, dt_limit))| {
+                simd::dispatch(|| pass.block(block * BLOCK, forces, dt_limit))
+            })
+            .sum()
+    })
 }
 
 impl Pass<'_> {
-    /// The particles of one block, from sorted index `first`, group by group.
+    /// The particles of one block, from sorted index `first`, group by group; returns how
+    /// many walls were spared the walk over their neighbours.
     #[inline(always)]
-    fn block(&self, first: usize, forces: &mut [[f32; 4]], dt_limit: &mut [f32]) {
+    fn block(&self, first: usize, forces: &mut [[f32; 4]], dt_limit: &mut [f32]) -> usize {
         let end = first + forces.len();
         let mut start = first;
+        let mut asleep = 0;
         while start < end {
             let group = self.grid.group(start, end, |k| self.sides[k].x);
-            let (sum, tau) = self.group(&group);
-            for (lane, i) in group.range.clone().enumerate() {
-                let mut s = sum.lane(lane);
-                for (a, t) in s.acc.iter_mut().zip(tau) {
-                    *a += t.0[lane];
+            let range = group.range.clone();
+            let (wet, spared) = self.walls_of(&group);
+            // A group of walls that need no pair sums is not walked at all; in a group
+            // with others, their lanes' sums are left unread.
+            let walk = !spared[..range.len()].iter().all(|s| *s);
+            let sums = walk.then(|| self.group(&group));
+            asleep += if walk { 0 } else { range.len() };
+            for (lane, i) in range.enumerate() {
+                let mut s = PairSum::default();
+                if let Some((sum, tau)) = sums.as_ref().filter(|_| !spared[lane]) {
+                    s = sum.lane(lane);
+                    for (a, t) in s.acc.iter_mut().zip(tau) {
+                        *a += t.0[lane];
+                    }
                 }
-                let (f, dt) = self.finish(i, &s);
-                forces[i - first] = f;
-                dt_limit[i - first] = dt;
+                (forces[i - first], dt_limit[i - first]) = self.finish(i, &s, wet[lane]);
             }
             start = group.range.end;
         }
+        asleep
+    }
+
+    /// For each lane of `group`: whether a mobile particle is in reach (always, for a mobile
+    /// particle or without the awake set), and whether it is a wall whose pair sums nothing
+    /// reads (see the module doc).
+    #[inline(always)]
+    fn walls_of(&self, group: &Group) -> ([bool; LANES], [bool; LANES]) {
+        let (mut wet, mut spared) = ([true; LANES], [false; LANES]);
+        let Some(mobile) = self.extra.mobile else {
+            return (wet, spared);
+        };
+        let generalised = self.model.params().generalised_walls;
+        for (lane, i) in group.range.clone().enumerate() {
+            let side = &self.sides[i];
+            if !side.mobile {
+                wet[lane] = self.grid.any_near(mobile, &side.x);
+                spared[lane] = generalised || !wet[lane];
+            }
+        }
+        (wet, spared)
     }
 
     /// The pair sums of `group` and, with the multiphase model, its stress divergence.
@@ -120,19 +164,22 @@ impl Pass<'_> {
         (sum, tau)
     }
 
-    /// Particle `i`'s forces and step from its sums.
-    fn finish(&self, i: usize, sum: &PairSum) -> ([f32; 4], f32) {
+    /// Particle `i`'s forces and step from its sums; a wall that is not `wet` has no mobile
+    /// particle within reach.
+    fn finish(&self, i: usize, sum: &PairSum, wet: bool) -> ([f32; 4], f32) {
         let side = &self.sides[i];
         let imposed = self.extra.imposed.get(i).copied().unwrap_or(false);
         let (mut f, mut dt) = self.model.finish(side, sum, !imposed);
         if !side.mobile && self.model.params().generalised_walls {
             // A wall's fourth entry is then its density, not a rate (`physics::boundary`).
             let mut wall = WallSums::default();
-            self.grid.rows(self.grid.coords(&side.x), |range| {
-                for j in range {
-                    self.model.add_wall_pair(side, &self.sides[j], &mut wall);
-                }
-            });
+            if wet {
+                self.grid.rows(self.grid.coords(&side.x), |range| {
+                    for j in range {
+                        self.model.add_wall_pair(side, &self.sides[j], &mut wall);
+                    }
+                });
+            }
             f[3] = self.model.wall_density(side, &wall);
         }
         if let Some((_, _, mu)) = self.extra.stress
@@ -179,7 +226,7 @@ mod tests {
                 for (a, t) in sum.acc.iter_mut().zip(tau) {
                     *a += t;
                 }
-                pass.finish(i, &sum)
+                pass.finish(i, &sum, true)
             })
             .unzip()
     }
@@ -206,14 +253,16 @@ mod tests {
             .num_threads(2)
             .build()
             .expect("a pool of two threads");
-        for viscosity in [
+        let viscosities = [
             Viscosity::Multiphase {
                 alpha: 0.05,
                 sps_length2: 0.0,
             },
             Viscosity::Laminar,
-        ] {
-            let fx = fixture(viscosity);
+        ];
+        for (viscosity, generalised) in viscosities.into_iter().zip([false, true]) {
+            let mut fx = fixture(viscosity);
+            fx.params.generalised_walls = generalised;
             let model = PairModel::new(&fx.params);
             let sides: Vec<Side> = (0..fx.pos.len())
                 .map(|i| model.side(&fx.pos[i], &fx.vel[i]))
@@ -222,29 +271,37 @@ mod tests {
             let (stress, mu) = stresses(&fx, &div);
             let imposed: Vec<bool> = (0..sides.len()).map(|i| i % 7 == 0).collect();
             let with_stress = matches!(viscosity, Viscosity::Multiphase { .. });
-            let extra = Extra {
+            let n = sides.len();
+            let mobile = Flagged::new(n, |k| sides[k].mobile);
+            let full = Extra {
                 stress: with_stress.then_some((&div, stress.as_slice(), mu.as_slice())),
                 imposed: &imposed,
+                mobile: None,
             };
-            let pass = Pass {
+            let awake = Extra {
+                mobile: Some(&mobile),
+                ..full
+            };
+            let pass = |extra| Pass {
                 model: &model,
                 grid: &fx.grid,
                 sides: &sides,
-                extra: &extra,
+                extra,
             };
-            let (want_f, want_dt) = one_by_one(&pass);
-            let n = sides.len();
+            let (want_f, want_dt) = one_by_one(&pass(&full));
             // Not a vacuous comparison: nearly every particle feels more than gravity.
             let pushed = want_f.iter().filter(|f| f[1] != -9.81).count();
             assert!(pushed > n * 9 / 10, "{pushed} of {n}");
 
-            let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
-            force_pass(&pool, &model, &fx.grid, &sides, &extra, &mut f, &mut dt);
-            assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
-            // The baseline copy, without the AVX2 one, and the whole as one block.
-            let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
-            pass.block(0, &mut f, &mut dt);
-            assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
+            for extra in [&full, &awake] {
+                let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
+                force_pass(&pool, &model, &fx.grid, &sides, extra, &mut f, &mut dt);
+                assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
+                // The baseline copy, without the AVX2 one, and the whole as one block.
+                let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
+                pass(extra).block(0, &mut f, &mut dt);
+                assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
+            }
         }
     }
 }

@@ -210,6 +210,37 @@ impl Grid {
     pub fn reach(&self) -> i32 {
         self.reach
     }
+
+    /// Whether any particle that `flagged` counts lies in the cells within reach of `x`'s:
+    /// false means none is within the kernel's support of a particle at `x`.
+    #[inline]
+    pub fn any_near(&self, flagged: &Flagged, x: &[f32; 3]) -> bool {
+        let mut any = false;
+        self.rows(self.coords(x), |range| {
+            any |= flagged.before[range.end] != flagged.before[range.start];
+        });
+        any
+    }
+}
+
+/// A set of particles of the sorted order, as the running count of its members before each
+/// slot: how many lie in a row of cells is one subtraction.
+pub struct Flagged {
+    before: Vec<u32>,
+}
+
+impl Flagged {
+    /// The particles `k` of `0..n` for which `member(k)`.
+    pub fn new(n: usize, member: impl Fn(usize) -> bool) -> Flagged {
+        let mut before = Vec::with_capacity(n + 1);
+        let mut count = 0u32;
+        before.push(0);
+        for k in 0..n {
+            count += u32::from(member(k));
+            before.push(count);
+        }
+        Flagged { before }
+    }
 }
 
 /// `values` in sorted order: slot k holds the value of storage index `order[k]`.

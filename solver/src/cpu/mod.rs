@@ -29,15 +29,21 @@ use crate::physics::sediment::suspension::Region;
 use grid::Grid;
 use std::sync::Arc;
 
-/// The line naming the CPU backend on `threads` threads (0: one per core).
-pub fn describe(threads: usize) -> String {
+/// The line naming the CPU backend on `threads` threads (0: one per core), with its awake
+/// set or without.
+pub fn describe(threads: usize, awake_set: bool) -> String {
     let n = if threads == 0 {
         rayon::current_num_threads()
     } else {
         threads
     };
+    let full = if awake_set {
+        ""
+    } else {
+        ", every particle in full"
+    };
     format!(
-        "native CPU backend ({n} threads, {})",
+        "native CPU backend ({n} threads, {}{full})",
         std::env::consts::ARCH
     )
 }
@@ -86,11 +92,19 @@ pub struct CpuEngine {
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
     seconds: [f64; STAGES.len()],
+    /// Whether walls and held grains far from moving fluid sleep (`forces.rs`,
+    /// `multiphase.rs`); false computes every particle in full, to the same bits.
+    awake_set: bool,
+    /// Particles each neighbour pass of `STAGES` took, and how many of them slept.
+    passed: [u64; STAGES.len()],
+    asleep: [u64; STAGES.len()],
 }
 
 impl CpuEngine {
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         threads: usize,
+        awake_set: bool,
         params: &SimParams,
         n_phases: usize,
         sediment: Option<SedimentModel>,
@@ -122,11 +136,20 @@ impl CpuEngine {
             regions,
             probe_points: probe_points.to_vec(),
             seconds: [0.0; STAGES.len()],
+            awake_set,
+            passed: [0; STAGES.len()],
+            asleep: [0; STAGES.len()],
         })
     }
 
     fn grid(&self) -> Grid {
         Grid::new(&self.params, self.shape.divisions)
+    }
+
+    /// Counts a pass of stage `k` over `particles`, `asleep` of which slept.
+    fn count(&mut self, k: usize, particles: usize, asleep: usize) {
+        self.passed[k] += particles as u64;
+        self.asleep[k] += asleep as u64;
     }
 
     /// Adds the time since `start` to stage `k` of `STAGES`.
@@ -151,7 +174,7 @@ impl CpuEngine {
 
 impl Engine for CpuEngine {
     fn name(&self) -> String {
-        describe(self.threads)
+        describe(self.threads, self.awake_set)
     }
 
     fn write_params(&mut self, params: &SimParams) {
@@ -238,7 +261,13 @@ impl Engine for CpuEngine {
         STAGES
             .iter()
             .zip(self.seconds)
-            .map(|(&stage, seconds)| StageTime { stage, seconds })
+            .zip(self.passed.iter().zip(self.asleep))
+            .map(|((&stage, seconds), (&particles, asleep))| StageTime {
+                stage,
+                seconds,
+                particles,
+                asleep,
+            })
             .collect()
     }
 }

@@ -4,8 +4,16 @@
 //! lanes, a group of one row of cells at once, as the force pass takes them. A release reads
 //! the regions the rheology pass left, before any release, so it does not depend on the order
 //! threads run.
+//!
+//! The awake set: a grain held after the last pass with nothing but resting particles (held
+//! grains and walls at rest) in the cells within reach sleeps. Its sums would then hold no
+//! water and no velocity difference: it is not at the surface, its strain rate is zero, its
+//! concentration one, and it stays held with the viscosity its own density gives. That is
+//! what [`Rheology::finish`] gives from the particle's own start, to the bit, without the
+//! neighbour loop; its neighbours read only its position, velocity and density, which the
+//! pass does not change.
 
-use super::grid::{Grid, Group};
+use super::grid::{Flagged, Grid, Group};
 use super::simd;
 use crate::physics::Params;
 use crate::physics::interaction::phase_index;
@@ -24,6 +32,16 @@ pub struct Holds<'a> {
     /// The particles' ids (sorted order): their draws'.
     pub ids: &'a [u32],
     pub draws: Option<Draws>,
+    /// Whether held grains far from anything moving sleep (see the module doc); false: every
+    /// grain runs its sums (the full computation the awake set is checked against).
+    pub awake_set: bool,
+}
+
+/// The rheology of the active particles, and how many grains were spared the walk over their
+/// neighbours.
+pub struct RheologyPass {
+    pub out: Vec<ParticleRheology>,
+    pub asleep: usize,
 }
 
 /// The rheology of the active particles (sorted order), then, with `release`, the release of
@@ -38,7 +56,7 @@ pub fn rheology_pass(
     vel: &[[f32; 4]],
     holds: &Holds,
     release: bool,
-) -> Vec<ParticleRheology> {
+) -> RheologyPass {
     let held_before = holds.before;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = held_before.len();
@@ -48,6 +66,21 @@ pub fn rheology_pass(
             .map(|i| (pass.volume(&pos[i], &vel[i]), pass.side(&pos[i], &vel[i])))
             .unzip()
     });
+    let asleep = if holds.awake_set {
+        let rests = |k: usize| {
+            let still = vel[k][..3].iter().all(|&v| v == 0.0);
+            still && (held_before[k] || !params.phases[phase_index(&pos[k])].mobile)
+        };
+        let stirring = Flagged::new(n, |k| !rests(k));
+        pool.install(|| {
+            (0..n)
+                .into_par_iter()
+                .map(|i| held_before[i] && !grid.any_near(&stirring, &sides[i].x))
+                .collect()
+        })
+    } else {
+        vec![false; n]
+    };
     let pairs = Pairs {
         params,
         pass: &pass,
@@ -57,6 +90,7 @@ pub fn rheology_pass(
         vol: &vol,
         sides: &sides,
         ids: holds.ids,
+        asleep: &asleep,
     };
     // Every slot is written by its block.
     let none = ParticleRheology {
@@ -66,10 +100,11 @@ pub fn rheology_pass(
         held: false,
     };
     let mut out = vec![none; n];
-    pool.install(|| {
+    let asleep = pool.install(|| {
         out.par_chunks_mut(BLOCK)
             .enumerate()
-            .for_each(|(b, out)| simd::dispatch(|| pairs.block(b * BLOCK, out, held_before)));
+            .map(|(b, out)| simd::dispatch(|| pairs.block(b * BLOCK, out, held_before)))
+            .sum()
     });
     if release {
         let stage = Release::new(params, model);
@@ -95,7 +130,7 @@ pub fn rheology_pass(
             r.region = Region::Yielded as u32;
         }
     }
-    out
+    RheologyPass { out, asleep }
 }
 
 /// Particles per block handed to a thread, as in the force pass.
@@ -111,25 +146,41 @@ struct Pairs<'a> {
     vol: &'a [f32],
     sides: &'a [RheologySide],
     ids: &'a [u32],
+    /// The grains that may sleep in this pass.
+    asleep: &'a [bool],
 }
 
 impl Pairs<'_> {
     /// The rheology of the particles from `first` into `out`, in groups of one row of cells
     /// as the force pass takes them: each lane sums its own neighbours in sorted order.
+    /// Returns how many were spared the walk over their neighbours.
     #[inline(always)]
-    fn block(&self, first: usize, out: &mut [ParticleRheology], held_before: &[bool]) {
+    fn block(&self, first: usize, out: &mut [ParticleRheology], held_before: &[bool]) -> usize {
+        let mut asleep = 0;
         let (pass, grid, pos, vel) = (self.pass, self.grid, self.pos, self.vel);
         let end = first + out.len();
         let mut start = first;
         while start < end {
             let group = grid.group(start, end, |k| self.sides[k].x);
-            let sums = self.group(&group);
-            for (lane, i) in group.range.clone().enumerate() {
-                let s = sums.lane(lane);
-                out[i - first] = pass.finish(&pos[i], &vel[i], &s, held_before[i], self.ids[i]);
+            // A group with an awake grain is walked whole: a sleeper's sums give it what its
+            // start does.
+            if group.range.clone().all(|i| self.asleep[i]) {
+                asleep += group.range.len();
+                for i in group.range.clone() {
+                    let s = pass.start(&pos[i], &vel[i]);
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, true, self.ids[i]);
+                }
+            } else {
+                let sums = self.group(&group);
+                for (lane, i) in group.range.clone().enumerate() {
+                    let s = sums.lane(lane);
+                    let held = held_before[i];
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, held, self.ids[i]);
+                }
             }
             start = group.range.end;
         }
+        asleep
     }
 
     /// The sums of `group`, from each particle's own start.
@@ -181,20 +232,16 @@ mod tests {
         let held: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
         let ids: Vec<u32> = (0..n as u32).collect();
         let (params, grid) = (&fx.params, &fx.grid);
-        let got = rheology_pass(
-            &pool,
-            params,
-            &fx.sediment,
-            grid,
-            &fx.pos,
-            &fx.vel,
-            &Holds {
+        let pass_with = |awake_set| {
+            let holds = Holds {
                 before: &held,
                 ids: &ids,
                 draws: None,
-            },
-            false,
-        );
+                awake_set,
+            };
+            let (pos, vel) = (&fx.pos, &fx.vel);
+            rheology_pass(&pool, params, &fx.sediment, grid, pos, vel, &holds, false).out
+        };
         let pass = Rheology::new(params, &fx.sediment);
         // Particle by particle over `Grid::rows`, each pair by the f32 formulas.
         let want: Vec<ParticleRheology> = (0..n)
@@ -222,7 +269,9 @@ mod tests {
                 })
                 .collect()
         };
-        assert!(word_bits(&got) == word_bits(&want));
+        for awake_set in [false, true] {
+            assert!(word_bits(&pass_with(awake_set)) == word_bits(&want));
+        }
         // Not a vacuous comparison: the bed's top layer sees the water and yields or moves.
         let sand = (0..n).filter(|&i| fx.pos[i][3].to_bits() == SAND);
         let regions: std::collections::BTreeSet<u32> = sand.map(|i| want[i].region).collect();

@@ -5,7 +5,7 @@
 //! `dt_update.wgsl`.
 
 use super::forces::{Extra, force_pass, min_dt};
-use super::grid::Grid;
+use super::grid::{Flagged, Grid};
 use super::multiphase::{Holds, rheology_pass};
 use super::store::{Event, Store, tally};
 use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
@@ -58,10 +58,15 @@ impl CpuEngine {
                 before: &held[..active],
                 ids: &b.ids[..active],
                 draws,
+                awake_set: self.awake_set,
             };
             let release = self.shape.yield_release;
             let (params, pool) = (&self.model, &self.pool);
             rheology_pass(pool, params, model, grid, pos, vel, &holds, release)
+        });
+        let rheology = rheology.map(|pass| {
+            self.count(STAGE_RHEOLOGY, active, pass.asleep);
+            pass.out
         });
         if let Some(out) = &rheology {
             for (r, &id) in out.iter().zip(&b.ids) {
@@ -103,14 +108,16 @@ impl CpuEngine {
                     .unzip()
             })
         });
+        let mobile = Flagged::new(active, |k| sides[k].mobile);
         let extra = Extra {
             stress: stress
                 .as_ref()
                 .map(|(s, mu)| (&div, s.as_slice(), mu.as_slice())),
             imposed: &imposed,
+            mobile: self.awake_set.then_some(&mobile),
         };
         let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
-        force_pass(
+        let asleep = force_pass(
             &self.pool,
             &model,
             grid,
@@ -119,6 +126,7 @@ impl CpuEngine {
             &mut forces,
             &mut dt_limit,
         );
+        self.count(STAGE_FORCES, active, asleep);
         self.timed(STAGE_FORCES, start);
         (forces, dt_limit)
     }

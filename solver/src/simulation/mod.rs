@@ -177,8 +177,9 @@ impl Simulation {
                 &probes.points,
                 shape,
             )?),
-            Backend::Cpu { threads } => Box::new(crate::cpu::CpuEngine::new(
+            Backend::Cpu { threads, awake_set } => Box::new(crate::cpu::CpuEngine::new(
                 threads,
+                awake_set,
                 &params,
                 derived.phases.len(),
                 crate::contract::sediment_model(case, &derived),

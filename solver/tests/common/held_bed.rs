@@ -113,7 +113,7 @@ pub fn check_symplectic_steps_with_held_bed_walls(backend: &Backend) {
         let regions = sim.regions().expect("regions");
         (particles, sim.read_particles().expect("readback"), regions)
     };
-    let (start, cpu, cpu_regions) = run(&Backend::Cpu { threads: 2 });
+    let (start, cpu, cpu_regions) = run(&Backend::cpu(2));
     let (_, other, other_regions) = run(backend);
     assert_eq!(cpu_regions, other_regions, "the holds differ");
     let mut pressed = 0;

@@ -1,0 +1,115 @@
+//! The CPU backend's awake set (`cpu/forces.rs`, `cpu/multiphase.rs`): walls, and held grains
+//! far from anything moving, skip their neighbour loops. It must give the full computation's
+//! bits, so each case runs twice, with the awake set and without, while water reaches walls and
+//! held sand that were dry: every particle's position, velocity and density, and every region
+//! word, must agree to the bit. A sleeper that water reached unnoticed (a wall still at rest
+//! density, a grain still held away from the surface) would differ from the step it was
+//! reached.
+
+mod common;
+
+use common::case_path;
+use flume_solver::{Backend, Case, Simulation, StageTime};
+
+/// The run's state as bits: positions, velocities and densities, then region words.
+fn bits(sim: &Simulation) -> Vec<u32> {
+    let p = sim.read_particles().expect("readback");
+    let regions = sim.regions().expect("regions");
+    let values = p.positions.iter().chain(&p.vel_rho).flatten();
+    values.map(|v| v.to_bits()).chain(regions).collect()
+}
+
+/// Share of the particles of `stage` that slept over the passes between two readings.
+fn asleep_share(before: &[StageTime], after: &[StageTime], stage: &str) -> f64 {
+    let pick = |s: &[StageTime]| {
+        let s = s.iter().find(|s| s.stage == stage).expect("the stage");
+        (s.particles, s.asleep)
+    };
+    let ((p0, a0), (p1, a1)) = (pick(before), pick(after));
+    (a1 - a0) as f64 / (p1 - p0).max(1) as f64
+}
+
+/// Runs `case` to each of `times` with the awake set and without; the bits must agree at each.
+/// Returns the share of rheology and force passes that slept over the first and the last
+/// stretch.
+fn assert_same_as_full(case: &Case, times: &[f64]) -> [(f64, f64); 2] {
+    let awake = Backend::cpu(2);
+    let full = Backend::Cpu {
+        threads: 2,
+        awake_set: false,
+    };
+    let mut a = Simulation::new(awake, case).expect("builds");
+    let mut f = Simulation::new(full, case).expect("builds");
+    let mut shares = Vec::new();
+    for &t in times {
+        let before = a.stage_times();
+        a.advance_to(t).expect("runs with the awake set");
+        f.advance_to(t).expect("runs in full");
+        assert_eq!(a.steps(), f.steps(), "{}: steps to t = {t} s", case.name);
+        assert!(
+            bits(&a) == bits(&f),
+            "{}: the awake set differs from the full computation by t = {t} s",
+            case.name
+        );
+        let after = a.stage_times();
+        let share = |stage| asleep_share(&before, &after, stage);
+        shares.push((share("rheology"), share("forces")));
+        eprintln!(
+            "{} to t = {t} s: asleep in rheology {:.3}, in forces {:.3}",
+            case.name,
+            share("rheology"),
+            share("forces")
+        );
+    }
+    [shares[0], shares[shares.len() - 1]]
+}
+
+fn ulbra(overrides: &[&str]) -> Case {
+    let mut set = vec![
+        "numerics.dp_m=0.01".to_string(),
+        "open_flume.reservoir_particles=2500".to_string(),
+    ];
+    set.extend(overrides.iter().map(|s| s.to_string()));
+    Case::from_path_with(&case_path("../launch_configs/ulbra_flume.yaml"), &set)
+        .expect("the CI flume")
+}
+
+/// The CI flume as the twin runs it (generalised walls, the held bed a wall, van Rijn's
+/// pick-up): the front crosses 2 m of dry bed in its first 4 s, waking walls and held sand as it
+/// goes, and picks sand up.
+#[test]
+fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
+    let case = ulbra(&[
+        "numerics.boundary={method: generalised}",
+        "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
+        "phases.1.sediment.erosion=van_rijn_pickup",
+    ]);
+    let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5]);
+    // Not vacuous: walls and grains slept, and the front woke some (fewer slept at the end).
+    assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
+    assert!(
+        last.0 < first.0 && last.1 < first.1,
+        "{first:?} then {last:?}"
+    );
+}
+
+/// The paper's numerics on the same flume (dynamic boundaries, the held sand a mobile phase
+/// held at rest): walls sleep in the force pass, held grains in the rheology pass only.
+#[test]
+fn the_papers_flume_with_its_awake_set_is_the_full_computation() {
+    let case = ulbra(&[]);
+    let [first, last] = assert_same_as_full(&case, &[0.5, 2.0]);
+    assert!(first.0 > 0.2 && first.1 > 0.1, "{first:?}");
+    assert!(last.0 < first.0, "{first:?} then {last:?}");
+}
+
+/// Louvain's dam break over sand (Drucker-Prager with Shields, the release of held sand by its
+/// neighbours' stress): the release reads the rheology of sleeping grains.
+#[test]
+fn the_louvain_dam_break_with_its_awake_set_is_the_full_computation() {
+    let mut case =
+        Case::from_path(&case_path("../launch_configs/louvain_dambreak.yaml")).expect("parses");
+    case.numerics.dp_m = 0.01;
+    let [first, _] = assert_same_as_full(&case, &[0.05, 0.3]);
+    assert!(first.0 > 0.05, "{first:?}");
+}
