@@ -60,6 +60,10 @@ pub struct StageTime {
     pub seconds: f64,
     pub particles: u64,
     pub asleep: u64,
+    /// Lane-pairs its neighbour walks evaluated while counted (`Engine::count_lanes`), and
+    /// those of them that added to a sum read.
+    pub lane_pairs: u64,
+    pub useful_pairs: u64,
 }
 
 pub trait Engine: Send {
@@ -93,6 +97,9 @@ pub trait Engine: Send {
     fn observe(&self) -> Result<(Vec<[f32; 4]>, Extremes), SolverError>;
     /// Time per stage so far; empty where the backend cannot time its stages apart.
     fn stage_times(&self) -> Vec<StageTime>;
+    /// Counts the lane-pairs of each force pass from now (`on`) or no longer: a second walk
+    /// over the neighbours, for `bench`. Backends without lanes ignore it.
+    fn count_lanes(&mut self, _on: bool) {}
 }
 
 /// Which optional stages a case's pipeline has.

@@ -36,6 +36,8 @@ struct Measurement {
     backend: String,
     /// Seconds per stage over the timed stretch; empty where the backend cannot time them.
     stages: Vec<StageTime>,
+    /// Share of the force pass's lane-pairs that added to a sum read, counted after it.
+    lanes: Option<f64>,
 }
 
 impl Measurement {
@@ -263,6 +265,12 @@ fn print_stages(m: &Measurement) {
             awake.join(", ")
         );
     }
+    if let Some(share) = m.lanes {
+        println!(
+            "  lanes: {:.1} % of the force pass's lane-pairs add to a sum read",
+            100.0 * share
+        );
+    }
 }
 
 fn throughput_table() -> Table {
@@ -405,8 +413,11 @@ fn measure_from(
             seconds: now.seconds - before.seconds,
             particles: now.particles - before.particles,
             asleep: now.asleep - before.asleep,
+            lane_pairs: 0,
+            useful_pairs: 0,
         })
         .collect();
+    let lanes = count_lanes(&mut sim, 0.1 * wall_target_s)?;
     Ok(Measurement {
         particles: sim.particle_count() - parked,
         fluid: sim.fluid_count() - parked,
@@ -416,7 +427,31 @@ fn measure_from(
         start_s,
         backend: sim.backend_name(),
         stages,
+        lanes,
     })
+}
+
+/// After the timed stretch, the share of the force pass's evaluated lane-pairs that added to a
+/// sum read, over about `wall_s` more; None where the backend has no lanes.
+fn count_lanes(sim: &mut Simulation, wall_s: f64) -> Result<Option<f64>> {
+    let pick = |sim: &Simulation| {
+        let stages = sim.stage_times();
+        let forces = stages.into_iter().find(|s| s.stage == "forces")?;
+        Some((forces.lane_pairs, forces.useful_pairs))
+    };
+    let Some(before) = pick(sim) else {
+        return Ok(None);
+    };
+    sim.count_lanes(true);
+    let started = Instant::now();
+    while started.elapsed().as_secs_f64() < wall_s {
+        let t = sim.time_s() + 8.0 * sim.last_dt_s();
+        sim.advance_to(t).context("counting the lanes")?;
+    }
+    sim.count_lanes(false);
+    let after = pick(sim).unwrap_or(before);
+    let evaluated = (after.0 - before.0) as f64;
+    Ok((evaluated > 0.0).then(|| (after.1 - before.1) as f64 / evaluated))
 }
 
 #[cfg(test)]

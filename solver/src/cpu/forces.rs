@@ -49,6 +49,41 @@ struct Pass<'a> {
     extra: &'a Extra<'a>,
 }
 
+/// Lane-pairs a force pass evaluates and those of them that add to a sum read: how full the
+/// lanes are.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LaneUse {
+    pub evaluated: u64,
+    pub useful: u64,
+}
+
+/// The [`LaneUse`] of the force pass over `sides` (as [`force_pass`] takes them), without
+/// computing it.
+pub fn lane_use(
+    pool: &rayon::ThreadPool,
+    model: &PairModel,
+    grid: &Grid,
+    sides: &[Side],
+    extra: &Extra,
+) -> LaneUse {
+    let pass = Pass {
+        model,
+        grid,
+        sides,
+        extra,
+    };
+    let blocks = sides.len().div_ceil(BLOCK);
+    pool.install(|| {
+        (0..blocks)
+            .into_par_iter()
+            .map(|b| pass.census(b * BLOCK, ((b + 1) * BLOCK).min(sides.len())))
+            .reduce(LaneUse::default, |a, b| LaneUse {
+                evaluated: a.evaluated + b.evaluated,
+                useful: a.useful + b.useful,
+            })
+    })
+}
+
 /// Fills `forces` (`[ax, ay, az, d rho/dt]`) and `dt_limit` (the stable step before the CFL
 /// factor) of each particle of `sides`, in sorted order; cells come from `grid`, whose
 /// starts were sorted from the same particles or from the state half a step before. Returns
@@ -110,6 +145,37 @@ impl Pass<'_> {
             start = group.range.end;
         }
         asleep
+    }
+
+    /// The lane-pairs the walks of the particles from `first` to `end` evaluate, and those
+    /// within the kernel's support for a lane whose sums are read and a pair that adds
+    /// something (not two walls): what [`Pass::block`] walks, counted.
+    fn census(&self, first: usize, end: usize) -> LaneUse {
+        let support2 = (2.0 * self.model.params().h).powi(2);
+        let mut count = LaneUse::default();
+        let mut start = first;
+        while start < end {
+            let group = self.grid.group(start, end, |k| self.sides[k].x);
+            let range = group.range.clone();
+            let (_, spared) = self.walls_of(&group);
+            if !spared[..range.len()].iter().all(|s| *s) {
+                self.grid.row_span(group.cell, group.last_x(), |cands, _| {
+                    count.evaluated += (cands.len() * LANES) as u64;
+                    for j in cands {
+                        let (b, x_j) = (&self.sides[j], self.sides[j].x);
+                        for (lane, i) in range.clone().enumerate() {
+                            let a = &self.sides[i];
+                            let r2: f32 = (0..3).map(|k| (a.x[k] - x_j[k]).powi(2)).sum();
+                            let adds = a.mobile || b.mobile;
+                            let useful = !spared[lane] && adds && i != j && r2 < support2;
+                            count.useful += u64::from(useful);
+                        }
+                    }
+                });
+            }
+            start = range.end;
+        }
+        count
     }
 
     /// For each lane of `group`: whether a mobile particle is in reach (always, for a mobile
@@ -245,6 +311,41 @@ mod tests {
                 (div.side(&fx.pos[i], fx.vel[i][3], &t), 1e-3 * s)
             })
             .unzip()
+    }
+
+    /// The census counts, among the lane-pairs it evaluates, every pair within the support
+    /// that has a mobile side, once: the brute-force count over all pairs.
+    #[test]
+    fn the_lane_census_finds_every_pair_within_the_support() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of two threads");
+        let fx = fixture(Viscosity::Laminar);
+        let model = PairModel::new(&fx.params);
+        let sides: Vec<Side> = (0..fx.pos.len())
+            .map(|i| model.side(&fx.pos[i], &fx.vel[i]))
+            .collect();
+        let support2 = (2.0 * fx.params.h).powi(2);
+        let n = sides.len();
+        let brute = (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j)))
+            .filter(|&(i, j)| i != j && (sides[i].mobile || sides[j].mobile))
+            .filter(|&(i, j)| {
+                let r2: f32 = (0..3)
+                    .map(|k| (sides[i].x[k] - sides[j].x[k]).powi(2))
+                    .sum();
+                r2 < support2
+            })
+            .count() as u64;
+        let extra = Extra {
+            stress: None,
+            imposed: &[],
+            mobile: None,
+        };
+        let lanes = lane_use(&pool, &model, &fx.grid, &sides, &extra);
+        assert_eq!(lanes.useful, brute);
+        assert!(lanes.evaluated > 2 * lanes.useful, "{lanes:?}");
     }
 
     #[test]

@@ -98,6 +98,10 @@ pub struct CpuEngine {
     /// Particles each neighbour pass of `STAGES` took, and how many of them slept.
     passed: [u64; STAGES.len()],
     asleep: [u64; STAGES.len()],
+    /// Whether each force pass is followed by a count of its lane-pairs (`bench`), and the
+    /// count so far.
+    count_lanes: bool,
+    lanes: forces::LaneUse,
 }
 
 impl CpuEngine {
@@ -139,6 +143,8 @@ impl CpuEngine {
             awake_set,
             passed: [0; STAGES.len()],
             asleep: [0; STAGES.len()],
+            count_lanes: false,
+            lanes: forces::LaneUse::default(),
         })
     }
 
@@ -262,12 +268,26 @@ impl Engine for CpuEngine {
             .iter()
             .zip(self.seconds)
             .zip(self.passed.iter().zip(self.asleep))
-            .map(|((&stage, seconds), (&particles, asleep))| StageTime {
-                stage,
-                seconds,
-                particles,
-                asleep,
+            .enumerate()
+            .map(|(k, ((&stage, seconds), (&particles, asleep)))| {
+                let lanes = if k == STAGE_FORCES {
+                    self.lanes
+                } else {
+                    forces::LaneUse::default()
+                };
+                StageTime {
+                    stage,
+                    seconds,
+                    particles,
+                    asleep,
+                    lane_pairs: lanes.evaluated,
+                    useful_pairs: lanes.useful,
+                }
             })
             .collect()
+    }
+
+    fn count_lanes(&mut self, on: bool) {
+        self.count_lanes = on;
     }
 }

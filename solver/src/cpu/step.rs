@@ -4,7 +4,7 @@
 //! are `physics::integrate`'s; `store.rs` ends each particle's step, and `dt_update` mirrors
 //! `dt_update.wgsl`.
 
-use super::forces::{Extra, force_pass, min_dt};
+use super::forces::{Extra, force_pass, lane_use, min_dt};
 use super::grid::{Flagged, Grid};
 use super::multiphase::{Holds, rheology_pass};
 use super::store::{Event, Store, tally};
@@ -126,8 +126,15 @@ impl CpuEngine {
             &mut forces,
             &mut dt_limit,
         );
+        let lanes = self
+            .count_lanes
+            .then(|| lane_use(&self.pool, &model, grid, &sides, &extra));
         self.count(STAGE_FORCES, active, asleep);
         self.timed(STAGE_FORCES, start);
+        if let Some(lanes) = lanes {
+            self.lanes.evaluated += lanes.evaluated;
+            self.lanes.useful += lanes.useful;
+        }
         (forces, dt_limit)
     }
 

@@ -229,6 +229,11 @@ impl Simulation {
     pub fn stage_times(&self) -> Vec<StageTime> {
         self.engine.stage_times()
     }
+    /// Counts the lane-pairs of every force pass from now (`on`), into [`Simulation::stage_times`],
+    /// or no longer; a second walk over the neighbours, so not while timing.
+    pub fn count_lanes(&mut self, on: bool) {
+        self.engine.count_lanes(on);
+    }
     pub fn particle_count(&self) -> usize {
         self.initial_particles.len()
     }
