@@ -67,17 +67,7 @@ pub fn rheology_pass(
             .unzip()
     });
     let asleep = if holds.awake_set {
-        let rests = |k: usize| {
-            let still = vel[k][..3].iter().all(|&v| v == 0.0);
-            still && (held_before[k] || !params.phases[phase_index(&pos[k])].mobile)
-        };
-        let stirring = Flagged::new(n, |k| !rests(k));
-        pool.install(|| {
-            (0..n)
-                .into_par_iter()
-                .map(|i| held_before[i] && !grid.any_near(&stirring, &sides[i].x))
-                .collect()
-        })
+        sleepers(pool, params, grid, (pos, vel), held_before, &sides)
     } else {
         vec![false; n]
     };
@@ -131,6 +121,29 @@ pub fn rheology_pass(
         }
     }
     RheologyPass { out, asleep }
+}
+
+/// The grains that may sleep (see the module doc): held before, with nothing but held grains
+/// and walls at rest in the cells within reach.
+fn sleepers(
+    pool: &rayon::ThreadPool,
+    params: &Params,
+    grid: &Grid,
+    (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+    held_before: &[bool],
+    sides: &[RheologySide],
+) -> Vec<bool> {
+    let rests = |k: usize| {
+        let still = vel[k][..3].iter().all(|&v| v == 0.0);
+        still && (held_before[k] || !params.phases[phase_index(&pos[k])].mobile)
+    };
+    let stirring = Flagged::new(held_before.len(), |k| !rests(k));
+    pool.install(|| {
+        (0..held_before.len())
+            .into_par_iter()
+            .map(|i| held_before[i] && !grid.any_near(&stirring, &sides[i].x))
+            .collect()
+    })
 }
 
 /// Particles per block handed to a thread, as in the force pass.

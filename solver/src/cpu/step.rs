@@ -13,8 +13,8 @@ use crate::contract::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, bed_wall, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
-use crate::physics::sediment::pass::Draws;
 use crate::physics::sediment::pass::REGION_HELD;
+use crate::physics::sediment::pass::{Draws, ParticleRheology};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
@@ -52,31 +52,7 @@ impl CpuEngine {
     ) -> (Vec<[f32; 4]>, Vec<f32>) {
         let active = grid.active() as usize;
         let start = Instant::now();
-        let rheology = self.sediment.as_ref().map(|model| {
-            let held = self.holds(b);
-            let holds = Holds {
-                before: &held[..active],
-                ids: &b.ids[..active],
-                draws,
-                awake_set: self.awake_set,
-            };
-            let release = self.shape.yield_release;
-            let (params, pool) = (&self.model, &self.pool);
-            rheology_pass(pool, params, model, grid, pos, vel, &holds, release)
-        });
-        let rheology = rheology.map(|pass| {
-            self.count(STAGE_RHEOLOGY, active, pass.asleep);
-            pass.out
-        });
-        if let Some(out) = &rheology {
-            for (r, &id) in out.iter().zip(&b.ids) {
-                self.regions[id as usize] = r.word();
-            }
-            // Parked particles are out of the flow: no region.
-            for &id in &b.ids[active..] {
-                self.regions[id as usize] = 0;
-            }
-        }
+        let rheology = self.rheology(grid, b, (pos, vel), draws);
         self.timed(STAGE_RHEOLOGY, start);
         let start = Instant::now();
         let model = PairModel::new(&self.model);
@@ -136,6 +112,38 @@ impl CpuEngine {
             self.lanes.useful += lanes.useful;
         }
         (forces, dt_limit)
+    }
+
+    /// The rheology (and release) of the active particles of `b`, None without the
+    /// multiphase model; the regions it leaves are stored by id.
+    fn rheology(
+        &mut self,
+        grid: &Grid,
+        b: &State,
+        (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+        draws: Option<Draws>,
+    ) -> Option<Vec<ParticleRheology>> {
+        let active = grid.active() as usize;
+        let model = self.sediment.as_ref()?;
+        let held = self.holds(b);
+        let holds = Holds {
+            before: &held[..active],
+            ids: &b.ids[..active],
+            draws,
+            awake_set: self.awake_set,
+        };
+        let release = self.shape.yield_release;
+        let (params, pool) = (&self.model, &self.pool);
+        let pass = rheology_pass(pool, params, model, grid, pos, vel, &holds, release);
+        self.count(STAGE_RHEOLOGY, active, pass.asleep);
+        for (r, &id) in pass.out.iter().zip(&b.ids) {
+            self.regions[id as usize] = r.word();
+        }
+        // Parked particles are out of the flow: no region.
+        for &id in &b.ids[active..] {
+            self.regions[id as usize] = 0;
+        }
+        Some(pass.out)
     }
 
     /// One step; false once the chunk has no more to do (its time reached, or a health flag
