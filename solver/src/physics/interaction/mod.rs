@@ -382,9 +382,13 @@ impl<'a> PairModel<'a> {
     /// and its accumulators in the pair loop's lanes cost every particle a third of its speed.
     #[inline]
     pub fn add_wall_pair(&self, i: &Side, j: &Side, sums: &mut WallSums) {
+        // Most of a wall's neighbours are walls: they are out before any arithmetic.
+        if !j.mobile || j.imposed {
+            return;
+        }
         let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
         let r2 = dot3(x_ij, x_ij);
-        if !j.mobile || j.imposed || r2 >= self.support2 || r2 < self.coincident2 {
+        if r2 >= self.support2 || r2 < self.coincident2 {
             return;
         }
         let p_j = j.p_over_rho2 * j.rho * j.rho;
