@@ -416,3 +416,44 @@ fn overrides_change_a_case_and_are_validated_like_the_file() {
         }
     }
 }
+
+/// Whether the held bed stands as a wall is said twice, by the case (the bed-contact check's
+/// felt factor) and by the uniform both engines read (`SimParams::held_bed_is_wall`, as
+/// `params.wgsl`): the two agree on the flume under each boundary and release, and on
+/// Louvain's Drucker-Prager bed under the generalised walls.
+#[test]
+fn the_case_and_the_uniform_agree_on_a_held_bed_standing_as_a_wall() {
+    let variants: [(&str, &[&str], bool); 4] = [
+        ("ulbra_flume.yaml", &[], false),
+        (
+            "ulbra_flume.yaml",
+            &["numerics.boundary={method: generalised}"],
+            true,
+        ),
+        (
+            "ulbra_flume.yaml",
+            &[
+                "numerics.boundary={method: generalised}",
+                "phases.1.sediment.erosion=van_rijn_pickup",
+            ],
+            true,
+        ),
+        (
+            "louvain_dambreak.yaml",
+            &["numerics.boundary={method: generalised}"],
+            false,
+        ),
+    ];
+    for (name, set, want) in variants {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../launch_configs")
+            .join(name);
+        let mut set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        set.push("numerics.dp_m=0.02".to_string());
+        let case = Case::from_path_with(&path, &set).unwrap_or_else(|e| panic!("{e}"));
+        let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &case)
+            .unwrap_or_else(|e| panic!("{name} {set:?}: {e}"));
+        assert_eq!(case.held_bed_is_wall(), want, "{name} {set:?}");
+        assert_eq!(sim.params().held_bed_is_wall(), want, "{name} {set:?}");
+    }
+}
