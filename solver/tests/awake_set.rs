@@ -93,6 +93,20 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
     );
 }
 
+/// The same under the symplectic scheme, whose corrector's passes read the predictor's holds
+/// and the half step's velocities.
+#[test]
+fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
+    let case = ulbra(&[
+        "numerics.boundary={method: generalised}",
+        "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
+        "phases.1.sediment.erosion=van_rijn_pickup",
+        "numerics.integrator={method: symplectic}",
+    ]);
+    let [first, _] = assert_same_as_full(&case, &[0.5, 2.0]);
+    assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
+}
+
 /// The paper's numerics on the same flume (dynamic boundaries, the held sand a mobile phase
 /// held at rest): walls sleep in the force pass, held grains in the rheology pass only.
 #[test]
