@@ -118,6 +118,17 @@ pub struct RunArgs {
     pub foxglove: Option<u16>,
 }
 
+impl RunArgs {
+    /// The pace the command line sets, before any parameter.
+    pub fn pace(&self) -> crate::twin::settings::Pace {
+        crate::twin::settings::Pace {
+            target_rtf: self.target_rtf,
+            publish_rate_hz: self.publish_rate_hz,
+            stale_after_s: self.stale_after_s,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum GaugeMsg {
     WaterLevel,

@@ -7,6 +7,7 @@
 //! samples, applies each discharge at its stamp and makes the outputs; only the pace is this
 //! module's. With `--publish` the sensor topics go on the wire instead (`play`).
 
+use crate::adapters::bag::samples::{decode, role};
 use crate::adapters::bag::writer::Channel as BagChannel;
 use crate::adapters::bag::{BagFile, BagMessage, BagWriter};
 use crate::adapters::files::series_plot::SeriesPlots;
@@ -15,7 +16,7 @@ use crate::adapters::topics;
 use crate::cli::ReplayArgs;
 use crate::twin::gate::Limits;
 use crate::twin::messages::Outputs;
-use crate::twin::samples::{Input, decode, role};
+use crate::twin::samples::Input;
 use crate::twin::settings::{Settings, mount_heights};
 use crate::twin::solver_thread::{self, Report};
 use crate::twin::{Options, Twin, gauge_names};
@@ -121,7 +122,8 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
     let gauge_names = gauge_names(&case);
     let feed = Feed::read(args, &recording, &gauge_names)?;
     let limits = Limits::for_case(&case, args.future_tolerance_s);
-    let mount_height_m = mount_heights(&ros, &gauge_names, limits.flume_height_m)?;
+    let params = ros.parameters(&ros.node_fqn("flume_twin"))?;
+    let mount_height_m = mount_heights(&params, &gauge_names, limits.flume_height_m)?;
     println!(
         "replaying {} samples of {} up to {:.3} s of simulated time",
         feed.events.len(),

@@ -6,6 +6,7 @@
 //! a second, `/diagnostics`. This module knows topics and times, not SPH.
 
 use crate::adapters::bag::BagFile;
+use crate::adapters::bag::samples::{decode, role};
 use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
 use crate::adapters::files::series_plot::SeriesPlots;
 use crate::adapters::foxglove::LiveView;
@@ -16,7 +17,7 @@ use crate::adapters::ros::{dds_context, full_topic, outlet, qos, subscription};
 use crate::adapters::topics;
 use crate::cli::{GaugeMsg, RunArgs};
 use crate::twin::gate::Limits;
-use crate::twin::samples::{Sample, decode, role};
+use crate::twin::samples::Sample;
 use crate::twin::settings::Settings;
 use crate::twin::solver_thread::{self, FrameSettings, Report};
 use crate::twin::{Options, Published, Service, Twin, gauge_names};
@@ -55,7 +56,8 @@ pub fn run(args: &RunArgs, ros_args: &[String]) -> Result<()> {
         .collect();
     let limits = Limits::for_case(&case, args.future_tolerance_s);
     // Range sensors are mounted at the flume's top unless a parameter says otherwise.
-    let settings = Settings::new(args, &gauges, limits.flume_height_m, &ros.parameters(&fqn)?)?;
+    let params = ros.parameters(&fqn)?;
+    let settings = Settings::new(args.pace(), &gauges, limits.flume_height_m, &params)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()

@@ -1,11 +1,7 @@
 //! Sensor samples as the twin takes them, from the wire or from a recording: the message as it
 //! came (so it can be recorded), and what the input gate needs from it.
 
-use crate::adapters::bag::BagMessage;
-use crate::adapters::topics;
 use crate::twin::gate::{GaugeSample, InputGate, Reading};
-use anyhow::Result;
-use flume_msgs::RosMessage;
 use flume_msgs::builtin_interfaces::Time;
 use flume_msgs::flume_msgs::{Discharge, WaterLevel};
 use flume_msgs::sensor_msgs::Range;
@@ -124,30 +120,4 @@ impl Sample {
             },
         }
     }
-}
-
-/// What a recorded topic is to the twin: the inflow (`Some(None)`), gauge `k`
-/// (`Some(Some(k))`), or nothing. A topic matches by its last segments (`.../inflow`,
-/// `.../gauges/p1`) whatever namespace it was recorded in, and by its type.
-pub fn role(msg: &BagMessage, gauges: &[String]) -> Option<Option<usize>> {
-    let ends =
-        |name: &str| msg.topic == format!("/{name}") || msg.topic.ends_with(&format!("/{name}"));
-    if msg.schema_name == Discharge::DEF.schema_name() && ends(topics::INFLOW) {
-        return Some(None);
-    }
-    let gauge_type = msg.schema_name == WaterLevel::DEF.schema_name()
-        || msg.schema_name == Range::DEF.schema_name();
-    gauges
-        .iter()
-        .position(|g| gauge_type && ends(&topics::gauge(g)))
-        .map(Some)
-}
-
-/// Decodes a recorded sample of the role `role` (see [`role`]).
-pub fn decode(msg: &BagMessage, role: Option<usize>) -> Result<Sample> {
-    Ok(match role {
-        None => Sample::Inflow(msg.decode()?),
-        Some(k) if msg.schema_name == Range::DEF.schema_name() => Sample::Range(k, msg.decode()?),
-        Some(k) => Sample::Level(k, msg.decode()?),
-    })
 }

@@ -1,9 +1,35 @@
 //! The node's settings: the command line's, then parameter files and `-p` (which win), then
 //! `ros2 param set` on a running node. Each is checked here, with the reason for a refusal.
 
-use crate::adapters::ros::args::{ParamValue, RosArgs};
-use crate::cli::RunArgs;
 use anyhow::{Result, anyhow};
+
+/// A parameter value as the command line or a parameter file gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamValue {
+    Bool(bool),
+    Integer(i64),
+    Double(f64),
+    String(String),
+}
+
+impl ParamValue {
+    /// The value as a number, for numeric parameters set as integers (`-p rate:=2`).
+    pub fn as_f64(&self) -> Option<f64> {
+        match self {
+            ParamValue::Integer(i) => Some(*i as f64),
+            ParamValue::Double(d) => Some(*d),
+            _ => None,
+        }
+    }
+}
+
+/// The pace of a run as its command line gives it, before any parameter.
+#[derive(Debug, Clone, Copy)]
+pub struct Pace {
+    pub target_rtf: f64,
+    pub publish_rate_hz: f64,
+    pub stale_after_s: f64,
+}
 
 /// Settings of a run, from the command line, then parameter files and `-p` (which win).
 #[derive(Debug, Clone)]
@@ -24,15 +50,15 @@ impl Settings {
     /// Settings for gauges `gauges` (topic names), range sensors mounted at `flume_top_m`
     /// unless a parameter says otherwise.
     pub fn new(
-        args: &RunArgs,
+        pace: Pace,
         gauges: &[String],
         flume_top_m: f64,
         params: &[(String, ParamValue)],
     ) -> Result<Settings> {
         let mut s = Settings {
-            target_rtf: args.target_rtf,
-            publish_rate_hz: args.publish_rate_hz,
-            stale_after_s: args.stale_after_s,
+            target_rtf: pace.target_rtf,
+            publish_rate_hz: pace.publish_rate_hz,
+            stale_after_s: pace.stale_after_s,
             frame_id: "flume".into(),
             gauges: gauges.to_vec(),
             mount_height_m: vec![flume_top_m; gauges.len()],
@@ -174,29 +200,33 @@ pub fn describe(name: &str) -> Option<(&'static str, &'static str)> {
 }
 
 /// The height of each gauge's range sensor above the floor for an in-process replay: the
-/// live twin's parameters
-/// `gauge_mount_height_m.<gauge>` (the gauge's name in lower case) from `--ros-args -p` or
-/// `--params-file`, else the flume's top. The node's other parameters mean nothing to an
-/// in-process replay and are ignored; a name that is none of the node's is said.
-pub fn mount_heights(ros: &RosArgs, gauges: &[String], flume_top_m: f64) -> Result<Vec<f64>> {
+/// live twin's parameters `params` (from `--ros-args -p` or `--params-file`)
+/// `gauge_mount_height_m.<gauge>` (the gauge's name in lower case), else the flume's top. The
+/// node's other parameters mean nothing to an in-process replay and are ignored; a name that
+/// is none of the node's is said.
+pub fn mount_heights(
+    params: &[(String, ParamValue)],
+    gauges: &[String],
+    flume_top_m: f64,
+) -> Result<Vec<f64>> {
     let names: Vec<String> = gauges.iter().map(|g| g.to_lowercase()).collect();
     let mut s = Settings::for_replay(&names, vec![flume_top_m; names.len()], f64::INFINITY);
-    let params = ros.parameters(&ros.node_fqn("flume_twin"))?;
-    s.apply_at_start(&params, |name| name.starts_with(MOUNT_HEIGHT))?;
+    s.apply_at_start(params, |name| name.starts_with(MOUNT_HEIGHT))?;
     Ok(s.mount_height_m)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::adapters::ros::args::RosArgs;
     use crate::cli::{Cli, Command};
     use clap::Parser;
 
-    fn run_args(extra: &[&str]) -> RunArgs {
+    fn run_args(extra: &[&str]) -> Pace {
         let mut argv = vec!["flume-twin", "run", "case.yaml"];
         argv.extend_from_slice(extra);
         match Cli::parse_from(argv).command {
-            Command::Run(a) => a,
+            Command::Run(a) => a.pace(),
             _ => unreachable!("parsed a run"),
         }
     }
@@ -210,7 +240,7 @@ mod tests {
         let ros =
             RosArgs::parse(&["--params-file", file, "-p", "publish_rate_hz:=4"]).expect("parses");
         let s = Settings::new(
-            &run_args(&[]),
+            run_args(&[]),
             &["p1".to_string()],
             0.3,
             &ros.parameters("/flume/flume_twin").expect("reads"),
@@ -223,7 +253,7 @@ mod tests {
         assert_eq!(s.mount_height_m, vec![0.3], "the file's p1");
         let ros = RosArgs::parse(&["-p", "gauge_mount_height_m.p1:=0.25"]).expect("parses");
         let s = Settings::new(
-            &run_args(&[]),
+            run_args(&[]),
             &["p1".to_string()],
             0.3,
             &ros.parameters("/flume_twin").expect("reads"),
@@ -233,7 +263,7 @@ mod tests {
         // The file's p2 and p3 are not in this case: ignored, as is a p9 on the command line.
         let ros = RosArgs::parse(&["-p", "gauge_mount_height_m.p9:=0.25"]).expect("parses");
         let s = Settings::new(
-            &run_args(&[]),
+            run_args(&[]),
             &["p1".to_string()],
             0.3,
             &ros.parameters("/flume_twin").expect("reads"),
@@ -256,7 +286,7 @@ mod tests {
         ] {
             let ros = RosArgs::parse(&["-p", bad]).expect("parses");
             let err = Settings::new(
-                &run_args(&[]),
+                run_args(&[]),
                 &["p1".to_string()],
                 0.3,
                 &ros.parameters("/flume_twin").expect("reads"),
@@ -268,7 +298,8 @@ mod tests {
 
     fn heights(args: &[&str]) -> Result<Vec<f64>> {
         let gauges = ["P1".to_string(), "P2".to_string()];
-        mount_heights(&RosArgs::parse(args).expect("parses"), &gauges, 0.3)
+        let ros = RosArgs::parse(args).expect("parses");
+        mount_heights(&ros.parameters(&ros.node_fqn("flume_twin"))?, &gauges, 0.3)
     }
 
     #[test]

@@ -5,6 +5,7 @@
 
 pub mod directory;
 pub mod reader;
+pub mod samples;
 mod tail;
 pub mod tap;
 pub mod writer;

@@ -6,14 +6,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use serde_norway::Value;
 use std::path::{Path, PathBuf};
 
-/// A parameter value as the command line or a parameter file gives it.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ParamValue {
-    Bool(bool),
-    Integer(i64),
-    Double(f64),
-    String(String),
-}
+pub use crate::twin::settings::ParamValue;
 
 impl ParamValue {
     /// A YAML scalar, typed the way rclcpp types it: true/false, integers, floats, else text.
@@ -31,15 +24,6 @@ impl ParamValue {
         match serde_norway::from_str::<Value>(text) {
             Ok(v) => ParamValue::from_yaml(&v).unwrap_or_else(|| ParamValue::String(text.into())),
             Err(_) => ParamValue::String(text.into()),
-        }
-    }
-
-    /// The value as a number, for numeric parameters set as integers (`-p rate:=2`).
-    pub fn as_f64(&self) -> Option<f64> {
-        match self {
-            ParamValue::Integer(i) => Some(*i as f64),
-            ParamValue::Double(d) => Some(*d),
-            _ => None,
         }
     }
 }
