@@ -9,6 +9,8 @@
 //! the frame is skipped and counted. Resources a crashed twin or reader left in shared memory
 //! are removed when the twin starts.
 
+use crate::twin::solver_thread::{FrameSink, Opener};
+use crate::twin::visual::in_flume_frame;
 use anyhow::{Context, Result, anyhow};
 use flume_solver::{ParticleRegion, Particles, Simulation};
 use iceoryx2::port::notifier::Notifier;
@@ -60,11 +62,6 @@ pub struct FrameHeader {
     /// When the frame was sent, ns since the epoch (a reader's latency is its clock minus this).
     pub sent_unix_ns: u64,
     pub units: [u8; 32],
-}
-
-/// A vector in the flume frame (z up): a 2-D case's (x, vertical) becomes (x, 0, z).
-pub fn in_flume_frame(two_d: bool, [a, b, c]: [f32; 3]) -> [f32; 3] {
-    if two_d { [a, 0.0, b] } else { [a, b, c] }
 }
 
 /// The twin's end: the publisher, its notifier, and the pacing.
@@ -234,4 +231,33 @@ impl Frames {
         self.sent += 1;
         Ok(())
     }
+}
+
+impl FrameSink for Frames {
+    fn due(&self) -> bool {
+        Frames::due(self)
+    }
+
+    fn offer(&mut self, sim: &Simulation, p: &Particles) {
+        Frames::offer(self, sim, p);
+    }
+
+    fn skip(&mut self, why: &str) {
+        Frames::skip(self, why);
+    }
+
+    fn counts(&self) -> (u64, u64) {
+        (self.sent, self.skipped)
+    }
+}
+
+/// The solver thread's opener of frames on `service` at most `rate_hz` a wall second, for
+/// every particle of its simulation.
+pub fn frames_on(service: String, rate_hz: f64) -> Opener<dyn FrameSink> {
+    Box::new(move |sim: &Simulation| {
+        let parked = sim.parked_phase().unwrap_or(0);
+        let frames = Frames::open(&service, sim.particle_count(), parked, rate_hz)?;
+        println!("particle frames: iceoryx2 service {service}");
+        Ok(Box::new(frames) as Box<dyn FrameSink>)
+    })
 }

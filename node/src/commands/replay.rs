@@ -10,6 +10,7 @@
 use crate::adapters::bag::samples::{decode, role};
 use crate::adapters::bag::writer::Channel as BagChannel;
 use crate::adapters::bag::{BagFile, BagMessage, BagWriter};
+use crate::adapters::files::outputs::recorder_in;
 use crate::adapters::files::series_plot::SeriesPlots;
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::topics;
@@ -18,7 +19,7 @@ use crate::twin::gate::Limits;
 use crate::twin::messages::Outputs;
 use crate::twin::samples::Input;
 use crate::twin::settings::{Settings, mount_heights};
-use crate::twin::solver_thread::{self, Report};
+use crate::twin::solver_thread::{self, ChunkSinks, Report};
 use crate::twin::{Options, Twin, gauge_names};
 use anyhow::{Context, Result, anyhow, bail};
 use flume_msgs::RosMessage;
@@ -131,7 +132,11 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         feed.end
     );
     let case_name = case.name.clone();
-    let solver = solver_thread::spawn(case, args.csv.clone(), None)?;
+    let chunk_sinks = ChunkSinks {
+        recorder: args.csv.clone().map(recorder_in),
+        frames: None,
+    };
+    let solver = solver_thread::spawn(case, chunk_sinks)?;
     println!(
         "adapter: {}\nparticles: {}",
         solver.link.adapter, solver.link.particles

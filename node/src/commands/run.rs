@@ -8,8 +8,10 @@
 use crate::adapters::bag::BagFile;
 use crate::adapters::bag::samples::{decode, role};
 use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
+use crate::adapters::files::outputs::recorder_in;
 use crate::adapters::files::series_plot::SeriesPlots;
 use crate::adapters::foxglove::LiveView;
+use crate::adapters::frames::frames_on;
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::ros::parameters::{ParameterServices, ParameterStream, live_parameters};
 use crate::adapters::ros::services::{Call, Offered};
@@ -19,7 +21,7 @@ use crate::cli::{GaugeMsg, RunArgs};
 use crate::twin::gate::Limits;
 use crate::twin::samples::Sample;
 use crate::twin::settings::Settings;
-use crate::twin::solver_thread::{self, FrameSettings, Report};
+use crate::twin::solver_thread::{self, ChunkSinks, Report};
 use crate::twin::{Options, Published, Service, Twin, gauge_names};
 use anyhow::{Context as _, Result, anyhow, bail};
 use flume_msgs::builtin_interfaces::Time;
@@ -76,12 +78,13 @@ async fn serve(
     let namespace = ros.namespace.clone().unwrap_or_else(|| "/".into());
     let node_name = ros.node_name.clone().unwrap_or_else(|| "flume_twin".into());
     let gauge_names = gauge_names(&case);
-    let frames = (!args.no_frames).then(|| FrameSettings {
-        service: args.frames_service.clone(),
-        rate_hz: args.frames_rate_hz,
-    });
+    let sinks = ChunkSinks {
+        recorder: args.out.clone().map(recorder_in),
+        frames: (!args.no_frames)
+            .then(|| frames_on(args.frames_service.clone(), args.frames_rate_hz)),
+    };
     let case_name = case.name.clone();
-    let solver = solver_thread::spawn(case, args.out.clone(), frames)?;
+    let solver = solver_thread::spawn(case, sinks)?;
     let (adapter, particles) = (&solver.link.adapter, solver.link.particles);
     println!("adapter: {adapter}\nparticles: {particles}\nnode: {namespace} {node_name}");
     let live = Arc::new(Mutex::new(settings.clone()));

@@ -1,13 +1,10 @@
 //! The solver on a thread of its own: GPU work never blocks the async runtime. The node sends
 //! chunks (advance to t, changing the discharge on the way) and gets back one report per chunk.
 
-use crate::adapters::files::outputs::OutputFiles;
-use crate::adapters::frames::{Frames, in_flume_frame};
-use crate::twin::visual::CloudPoint;
+use crate::twin::visual::{CloudPoint, in_flume_frame};
 use anyhow::{Context, Result};
 use flume_solver::Particles;
 use flume_solver::{Backend, Case, InflowSchedule, Observations, Simulation};
-use std::path::PathBuf;
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 use std::time::Instant;
@@ -45,10 +42,34 @@ pub struct Report {
 }
 
 /// Where and how often the solver thread offers particle frames (iceoryx2).
-#[derive(Debug, Clone)]
-pub struct FrameSettings {
-    pub service: String,
-    pub rate_hz: f64,
+/// Where a run keeps its chunks besides the reports: its output files.
+pub trait Recorder {
+    /// The observations after chunk `k`, kept.
+    fn record(&mut self, sim: &Simulation, k: u64) -> Result<Observations>;
+    /// The run starts again from the case.
+    fn restart(&mut self);
+}
+
+/// Where the particle frames for visualisers go.
+pub trait FrameSink {
+    /// Whether a frame is due now.
+    fn due(&self) -> bool;
+    fn offer(&mut self, sim: &Simulation, p: &Particles);
+    /// A due frame that could not be read back, and why.
+    fn skip(&mut self, why: &str);
+    /// Frames sent and skipped so far.
+    fn counts(&self) -> (u64, u64);
+}
+
+/// Makes a run's recorder or frame sink from the simulation, on the solver's own thread (a
+/// shared-memory port stays on the thread that opened it).
+pub type Opener<T> = Box<dyn FnOnce(&Simulation) -> Result<Box<T>> + Send>;
+
+/// Where a run's chunks go besides its reports, as the adapters open them.
+#[derive(Default)]
+pub struct ChunkSinks {
+    pub recorder: Option<Opener<dyn Recorder>>,
+    pub frames: Option<Opener<dyn FrameSink>>,
 }
 
 /// The solver thread's end of the channels, and what it says when it starts.
@@ -72,18 +93,14 @@ pub struct SolverLink {
 /// `simulate`, one row per chunk; with `frames`, it offers the particles to visualisers after
 /// each chunk, when a frame is due (a frame service that cannot be opened is logged and left
 /// out: the twin runs without it).
-pub fn spawn(
-    case: Case,
-    out: Option<PathBuf>,
-    frames: Option<FrameSettings>,
-) -> Result<SolverThread> {
+pub fn spawn(case: Case, sinks: ChunkSinks) -> Result<SolverThread> {
     let (cmd_tx, cmd_rx) = mpsc::channel::<Command>();
     let (rep_tx, rep_rx) = async_mpsc::unbounded_channel();
     let (ready_tx, ready_rx) = mpsc::channel::<Result<(String, usize, Observations), String>>();
     let handle = std::thread::Builder::new()
         .name("flume-solver".into())
         .spawn(move || {
-            let mut worker = match Worker::start(case, out.as_deref()) {
+            let mut worker = match Worker::start(case, sinks.recorder) {
                 Ok(w) => w,
                 Err(e) => {
                     let _ = ready_tx.send(Err(e));
@@ -100,7 +117,7 @@ pub fn spawn(
                     return;
                 }
             }
-            worker.open_frames(frames);
+            worker.open_frames(sinks.frames);
             while let Ok(command) = cmd_rx.recv() {
                 let report = worker.handle(command);
                 let failed = report.is_err();
@@ -131,21 +148,19 @@ struct Worker {
     case: Case,
     backend: Backend,
     sim: Simulation,
-    recorder: Option<OutputFiles>,
-    frames: Option<Frames>,
+    recorder: Option<Box<dyn Recorder>>,
+    frames: Option<Box<dyn FrameSink>>,
     /// Chunks handled, the row number of the CSV files.
     chunks: u64,
 }
 
 impl Worker {
-    fn start(case: Case, out: Option<&std::path::Path>) -> Result<Worker, String> {
+    fn start(case: Case, recorder: Option<Opener<dyn Recorder>>) -> Result<Worker, String> {
         let started = (|| -> Result<Worker> {
             let backend = Backend::choose().context("cannot open a backend")?;
             let sim =
                 Simulation::new(backend.clone(), &case).context("cannot set up the simulation")?;
-            let recorder = out
-                .map(|dir| OutputFiles::create(dir, &case, sim.initial_particles(), None))
-                .transpose()?;
+            let recorder = recorder.map(|open| open(&sim)).transpose()?;
             Ok(Worker {
                 case,
                 backend,
@@ -158,22 +173,15 @@ impl Worker {
         started.map_err(|e| format!("{e:#}"))
     }
 
-    fn open_frames(&mut self, settings: Option<FrameSettings>) {
-        let parked = self.sim.parked_phase().unwrap_or(0);
-        let count = self.sim.particle_count();
-        self.frames =
-            settings.and_then(
-                |f| match Frames::open(&f.service, count, parked, f.rate_hz) {
-                    Ok(fr) => {
-                        println!("particle frames: iceoryx2 service {}", f.service);
-                        Some(fr)
-                    }
-                    Err(e) => {
-                        log::error!("no particle frames for visualisers: {e:#}");
-                        None
-                    }
-                },
-            );
+    /// Opens the frame sink; without it the run goes on, with the reason logged.
+    fn open_frames(&mut self, open: Option<Opener<dyn FrameSink>>) {
+        self.frames = open.and_then(|open| match open(&self.sim) {
+            Ok(sink) => Some(sink),
+            Err(e) => {
+                log::error!("no particle frames for visualisers: {e:#}");
+                None
+            }
+        });
     }
 
     fn handle(&mut self, command: Command) -> Result<Report, String> {
@@ -235,8 +243,8 @@ impl Worker {
             refused_inflows,
             cloud,
             reset: false,
-            frames_sent: self.frames.as_ref().map_or(0, |f| f.sent),
-            frames_skipped: self.frames.as_ref().map_or(0, |f| f.skipped),
+            frames_sent: self.frames.as_ref().map_or(0, |f| f.counts().0),
+            frames_skipped: self.frames.as_ref().map_or(0, |f| f.counts().1),
         })
     }
 }
@@ -275,7 +283,7 @@ fn run_chunk(
 fn read_back(
     sim: &Simulation,
     cloud: bool,
-    frames: Option<&mut Frames>,
+    frames: Option<&mut Box<dyn FrameSink>>,
 ) -> Result<Option<Particles>, String> {
     let frame = frames.filter(|f| f.due());
     if !cloud && frame.is_none() {

@@ -8,6 +8,11 @@ use flume_msgs::sensor_msgs::{PointCloud2, PointField};
 use flume_msgs::std_msgs::{ColorRGBA, Header};
 use flume_msgs::visualization_msgs::{Marker, MarkerArray};
 
+/// A vector in the flume frame (z up): a 2-D case's (x, vertical) becomes (x, 0, z).
+pub fn in_flume_frame(two_d: bool, [a, b, c]: [f32; 3]) -> [f32; 3] {
+    if two_d { [a, 0.0, b] } else { [a, b, c] }
+}
+
 /// Bytes per point: x, y, z, speed (float32 at 0, 4, 8, 12), phase (uint8 at 16), 3 of padding
 /// so that every point starts 4-byte aligned.
 pub const POINT_STEP: u32 = 20;

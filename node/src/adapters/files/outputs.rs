@@ -5,6 +5,7 @@ use crate::adapters::files::{
     csv::{BedProfileCsv, BudgetCsv, ErodedMassCsv, GaugeCsv, ProfileCsv},
     vtk,
 };
+use crate::twin::solver_thread::{Opener, Recorder};
 use anyhow::{Context, Result};
 use flume_solver::budget::{BudgetRow, SedimentBudget};
 use flume_solver::{Case, Observations, Particles, Simulation};
@@ -213,4 +214,23 @@ fn read_state(sim: &Simulation) -> Result<(Particles, Vec<u32>)> {
         .regions()
         .context("cannot read the particle regions back from the backend")?;
     Ok((particles, regions))
+}
+
+impl Recorder for OutputFiles {
+    fn record(&mut self, sim: &Simulation, k: u64) -> Result<Observations> {
+        OutputFiles::record(self, sim, k)
+    }
+
+    fn restart(&mut self) {
+        OutputFiles::restart(self);
+    }
+}
+
+/// The solver thread's opener of the output files in `dir` for its case, without particle
+/// snapshots.
+pub fn recorder_in(dir: std::path::PathBuf) -> Opener<dyn Recorder> {
+    Box::new(move |sim: &Simulation| {
+        let files = OutputFiles::create(&dir, sim.case(), sim.initial_particles(), None)?;
+        Ok(Box::new(files) as Box<dyn Recorder>)
+    })
 }
