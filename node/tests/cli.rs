@@ -104,15 +104,20 @@ fn bench_levels_refuses_bad_flags_before_it_runs() {
         );
         let mut all = vec!["bench", "--levels", "--flume", flume];
         all.extend(args);
-        let out = flume_twin(&all);
-        let stderr = text(&out.stderr);
-        assert!(!out.status.success(), "{all:?} ran");
-        assert!(stderr.contains(want), "{all:?}: {stderr}");
-        assert!(
-            !text(&out.stdout).contains("backend:"),
-            "{all:?} started a run"
-        );
+        assert_refused_first(&all, want, "backend:");
     }
+}
+
+/// `flume-twin ARGS` fails, its error names `want`, and it printed no `work` line first.
+fn assert_refused_first(all: &[&str], want: &str, work: &str) {
+    let out = flume_twin(all);
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "{all:?} ran");
+    assert!(stderr.contains(want), "{all:?}: {stderr}");
+    assert!(
+        !text(&out.stdout).contains(work),
+        "{all:?} started before refusing"
+    );
 }
 
 /// The timing `bench` refuses a start time that is no flume time and a value the flume case
@@ -136,14 +141,7 @@ fn bench_refuses_bad_flags_before_it_times() {
             flume.to_str().unwrap(),
         ]);
         all.extend(args);
-        let out = flume_twin(&all);
-        let stderr = text(&out.stderr);
-        assert!(!out.status.success(), "{all:?} ran");
-        assert!(stderr.contains(want), "{all:?}: {stderr}");
-        assert!(
-            !text(&out.stdout).contains("particle-steps"),
-            "{all:?} timed something"
-        );
+        assert_refused_first(&all, want, "particle-steps");
     }
 }
 

@@ -100,8 +100,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "each figure times whole steps for about {} s of wall time, after a warm-up",
         args.steps_seconds
     );
-    let mut failures = 0;
+    let tallies = [
+        time_ladder(args, &reference, &backends),
+        time_reference(args, &reference, &backends),
+        time_flume(args, &flume, &backends),
+    ];
+    let (failed, timed) = tallies
+        .iter()
+        .fold((0, 0), |(f, t), (df, dt)| (f + df, t + dt));
+    if failed > 0 {
+        bail!("{failed} of {timed} measurements failed (see above)");
+    }
+    Ok(())
+}
 
+/// Failed and attempted measurements of one section of the benchmark.
+type Tally = (usize, usize);
+
+/// The synthetic dam breaks of `--ladder` on each backend, as one table.
+fn time_ladder(args: &BenchArgs, reference: &Case, backends: &[Backend]) -> Tally {
     println!();
     println!(
         "synthetic 2-D dam breaks: a water column filling 1/4 of the tank, dp = {BENCH_DP_M} m, \
@@ -111,12 +128,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut table = throughput_table();
     let mut errors = Vec::new();
     for &n in &args.ladder {
-        for b in &backends {
+        for b in backends {
             let result = dam_break_case(n).and_then(|case| measure(b, &case, args.steps_seconds));
             match result {
                 Ok(m) => throughput_row(&mut table, &m),
                 Err(e) => {
-                    failures += 1;
                     table.row([format!("~{n}"), "failed".to_string()]);
                     errors.push(format!("~{n} particles: {e:#}"));
                 }
@@ -127,20 +143,26 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for e in &errors {
         println!("error: {e}");
     }
+    (errors.len(), args.ladder.len() * backends.len())
+}
 
+/// The DualSPHysics case on each backend, against DualSPHysics' own figure.
+fn time_reference(args: &BenchArgs, reference: &Case, backends: &[Backend]) -> Tally {
     println!();
     println!("case {} ({})", reference.name, args.case.display());
     let mut measured = Vec::new();
-    for b in &backends {
-        match measure(b, &reference, args.steps_seconds) {
+    for b in backends {
+        match measure(b, reference, args.steps_seconds) {
             Ok(m) => measured.push(m),
-            Err(e) => {
-                failures += 1;
-                println!("error: {e:#}");
-            }
+            Err(e) => println!("error: {e:#}"),
         }
     }
-    print_reference(&measured, &reference);
+    print_reference(&measured, reference);
+    (backends.len() - measured.len(), backends.len())
+}
+
+/// The open flume from `--from` on each backend, the CPU backend also in full.
+fn time_flume(args: &BenchArgs, flume: &Case, backends: &[Backend]) -> Tally {
     println!();
     let start = if args.from > 0.0 {
         format!("from t = {} s", args.from)
@@ -155,8 +177,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         args.flume.display(),
         flume.numerics.dp_m
     );
-    for b in with_full_cpu(&backends) {
-        match measure_from(&b, &flume, args.from, args.steps_seconds) {
+    let all = with_full_cpu(backends);
+    let mut failed = 0;
+    for b in &all {
+        match measure_from(b, flume, args.from, args.steps_seconds) {
             Ok(m) => {
                 let mut table = throughput_table();
                 throughput_row(&mut table, &m);
@@ -170,18 +194,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 print_stages(&m);
             }
             Err(e) => {
-                failures += 1;
+                failed += 1;
                 println!("error: {e:#}");
             }
         }
     }
-    if failures > 0 {
-        bail!(
-            "{failures} of {} measurements failed (see above)",
-            args.ladder.len() + 2
-        );
-    }
-    Ok(())
+    (failed, all.len())
 }
 
 /// The backends to time: the CPU backend, and the wgpu adapter when there is one, unless

@@ -11,7 +11,7 @@
 //! sums the mobile particles alone (`PairModel::add_pair`): with none in the cells within
 //! reach it is exactly zero, and the wall is not visited. A dry wall under the generalised
 //! condition takes rest density without a neighbour loop. Each of these is the value the full
-//! sums give, to the bit (`cpu_awake_set` in the solver's tests); nothing a mobile particle
+//! sums give, to the bit (`tests/awake_set.rs`); nothing a mobile particle
 //! reads is skipped, since every mobile particle runs its own sums.
 
 use super::grid::{Flagged, Grid, Group};

@@ -84,13 +84,15 @@ impl CpuEngine {
                     .unzip()
             })
         });
-        let mobile = Flagged::new(active, |k| sides[k].mobile);
+        let mobile = self
+            .awake_set
+            .then(|| Flagged::new(active, |k| sides[k].mobile));
         let extra = Extra {
             stress: stress
                 .as_ref()
                 .map(|(s, mu)| (&div, s.as_slice(), mu.as_slice())),
             imposed: &imposed,
-            mobile: self.awake_set.then_some(&mobile),
+            mobile: mobile.as_ref(),
         };
         let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
         let asleep = force_pass(
