@@ -12,7 +12,6 @@
 
 use crate::adapters::bag::writer::nanos;
 use crate::adapters::topics;
-use crate::cli::{GaugeMsg, RunArgs};
 use crate::twin::samples::Sample;
 use anyhow::{Context as _, Result};
 use flume_msgs::RosMessage;
@@ -43,6 +42,16 @@ struct Server {
 
 /// One topic's channel.
 pub struct LiveChannel(Arc<RawChannel>);
+
+/// Where the live view serves and how the gauges' topics read.
+pub struct ViewOptions {
+    /// The port (0: one the system picks), or none for no viewer.
+    pub port: Option<u16>,
+    /// Serve on the loopback interface only.
+    pub loopback: bool,
+    /// The gauges publish ultrasonic ranges (sensor_msgs/Range), not levels.
+    pub gauge_ranges: bool,
+}
 
 impl LiveView {
     /// Serves on `port` (0: one the system picks) when there is one: on the loopback
@@ -95,17 +104,18 @@ impl LiveView {
     /// The node's live view (`--foxglove`), with channels for the sensors' topics: the
     /// inflow's, then the gauges' in the case's order, as levels or as ranges.
     pub async fn for_node(
-        args: &RunArgs,
+        options: &ViewOptions,
         full: &dyn Fn(&str) -> String,
         gauge_names: &[String],
     ) -> Result<LiveView> {
-        let mut view = LiveView::start(args.foxglove, args.loopback).await?;
+        let mut view = LiveView::start(options.port, options.loopback).await?;
         let mut inputs = vec![view.channel::<Discharge>(&full(topics::INFLOW))?];
         for g in gauge_names {
             let topic = full(&topics::gauge(g));
-            inputs.push(match args.gauge_msg {
-                GaugeMsg::Range => view.channel::<Range>(&topic)?,
-                GaugeMsg::WaterLevel => view.channel::<WaterLevel>(&topic)?,
+            inputs.push(if options.gauge_ranges {
+                view.channel::<Range>(&topic)?
+            } else {
+                view.channel::<WaterLevel>(&topic)?
             });
         }
         view.inputs = inputs;

@@ -99,34 +99,9 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         log::warn!("{damage}; playing what comes before it");
         eprintln!("warning: {damage}; playing what comes before it");
     }
-    let selected = |topic: &str| args.topics.is_empty() || args.topics.iter().any(|t| t == topic);
-    let mut sensors: Vec<&BagMessage> = Vec::new();
-    let mut ignored: BTreeMap<&str, u64> = BTreeMap::new();
-    for m in &recording.messages {
-        if is_sensor(m) && selected(&m.topic) {
-            sensors.push(m);
-        } else {
-            *ignored.entry(&m.topic).or_default() += 1;
-        }
-    }
-    for (topic, n) in &ignored {
-        println!("not played: {topic} ({n} messages)");
-    }
-    sensors.sort_by_key(|m| m.log_ns);
-    let Some(first) = sensors.first() else {
-        bail!(
-            "{} holds no inflow or gauge topic to play{}",
-            args.recording.display(),
-            if args.topics.is_empty() {
-                ""
-            } else {
-                " among --topics"
-            }
-        );
-    };
-    let start_s = first.log_ns as f64 * 1e-9 + args.start_s;
+    let sensors = sensor_messages(args, &recording)?;
+    let start_s = sensors[0].log_ns as f64 * 1e-9 + args.start_s;
     let end_s = args.until.map_or(f64::INFINITY, |u| start_s + u);
-
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
@@ -144,120 +119,205 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         // subscribes /clock as builtin_interfaces/Time, a clash with the player's
         // rosgraph_msgs/Clock that RustDDS reports as an error.
         let clock = publisher::<Clock>(&mut node, &ros, topics::CLOCK, topics::STREAM_QOS)?;
-        let mut wires: Vec<Wire> = Vec::new();
-        let mut index: BTreeMap<&str, usize> = BTreeMap::new();
-        let mut plan: Vec<Due> = Vec::new();
-        let mut undecodable = 0u64;
-        for m in sensors {
-            let at_s = m.log_ns as f64 * 1e-9;
-            if at_s < start_s || at_s > end_s {
-                continue;
-            }
-            let payload = match payload(m) {
-                Ok(p) => p,
-                Err(e) => {
-                    undecodable += 1;
-                    log::warn!("{e:#}");
-                    continue;
-                }
-            };
-            let wire = match index.get(m.topic.as_str()) {
-                Some(&k) => k,
-                None => {
-                    let t = m.topic.as_str();
-                    wires.push(match payload {
-                        Payload::Inflow(_) => Wire::Inflow(publisher(
-                            &mut node,
-                            &ros,
-                            t,
-                            topics::INFLOW_QOS,
-                        )?),
-                        Payload::Level(_) => {
-                            Wire::Level(publisher(&mut node, &ros, t, topics::GAUGE_QOS)?)
-                        }
-                        Payload::Range(_) => {
-                            Wire::Range(publisher(&mut node, &ros, t, topics::GAUGE_QOS)?)
-                        }
-                    });
-                    println!("playing {t} as {}", full_topic("/", &ros, t));
-                    index.insert(t, wires.len() - 1);
-                    wires.len() - 1
-                }
-            };
-            plan.push(Due {
-                wire,
-                at_s,
-                payload,
-            });
-        }
-        if plan.is_empty() {
+        let plan = Plan::build(&mut node, &ros, sensors, start_s..=end_s)?;
+        if plan.due.is_empty() {
             bail!(
                 "nothing to play between {} s and {} s into the recording",
                 args.start_s,
                 args.start_s + args.until.unwrap_or(f64::INFINITY)
             );
         }
-        let rate = args.rate.unwrap_or(1.0);
-        let last_s = plan.last().map_or(start_s, |d| d.at_s);
+        let player = Player {
+            clock,
+            period: Duration::from_secs_f64(1.0 / args.clock_hz),
+            rate: args.rate.unwrap_or(1.0),
+            start_s,
+        };
         println!(
-            "playing {} samples on {} topics, {:.1} s of the recording from {start_s:.3} s since the epoch, at {rate} x, /clock at {} Hz",
-            plan.len(),
-            wires.len(),
-            last_s - start_s,
+            "playing {} samples on {} topics, {:.1} s of the recording from {start_s:.3} s since the epoch, at {} x, /clock at {} Hz",
+            plan.due.len(),
+            plan.wires.len(),
+            plan.last_s(start_s) - start_s,
+            player.rate,
             args.clock_hz,
         );
-        let send_clock = |t: f64| {
-            let stamp = Time::from_secs_f64(t).unwrap_or_default();
-            if let Err(e) = clock.publish(Clock { clock: stamp }) {
-                log::warn!("/clock could not be sent: {e:?}");
+        player.play(&plan, args.delay_s).await
+    })
+}
+
+/// The recording's sensor messages on the topics asked for, in log-time order, at least one;
+/// the count of every other topic's messages printed.
+fn sensor_messages<'a>(args: &ReplayArgs, recording: &'a BagFile) -> Result<Vec<&'a BagMessage>> {
+    let selected = |topic: &str| args.topics.is_empty() || args.topics.iter().any(|t| t == topic);
+    let mut sensors: Vec<&BagMessage> = Vec::new();
+    let mut ignored: BTreeMap<&str, u64> = BTreeMap::new();
+    for m in &recording.messages {
+        if is_sensor(m) && selected(&m.topic) {
+            sensors.push(m);
+        } else {
+            *ignored.entry(&m.topic).or_default() += 1;
+        }
+    }
+    for (topic, n) in &ignored {
+        println!("not played: {topic} ({n} messages)");
+    }
+    sensors.sort_by_key(|m| m.log_ns);
+    if sensors.is_empty() {
+        bail!(
+            "{} holds no inflow or gauge topic to play{}",
+            args.recording.display(),
+            if args.topics.is_empty() {
+                ""
+            } else {
+                " among --topics"
+            }
+        );
+    }
+    Ok(sensors)
+}
+
+/// What is to be played: a publisher per topic, and the samples in order.
+struct Plan {
+    wires: Vec<Wire>,
+    due: Vec<Due>,
+    /// Samples that could not be decoded (logged, not played).
+    undecodable: u64,
+}
+
+impl Plan {
+    /// The samples logged within `window` (s since the epoch), decoded, a publisher created
+    /// for each topic as it first comes.
+    fn build(
+        node: &mut Node,
+        ros: &RosArgs,
+        sensors: Vec<&BagMessage>,
+        window: std::ops::RangeInclusive<f64>,
+    ) -> Result<Plan> {
+        let mut plan = Plan {
+            wires: Vec::new(),
+            due: Vec::new(),
+            undecodable: 0,
+        };
+        let mut index: BTreeMap<&str, usize> = BTreeMap::new();
+        for m in sensors {
+            let at_s = m.log_ns as f64 * 1e-9;
+            if !window.contains(&at_s) {
+                continue;
+            }
+            let payload = match payload(m) {
+                Ok(p) => p,
+                Err(e) => {
+                    plan.undecodable += 1;
+                    log::warn!("{e:#}");
+                    continue;
+                }
+            };
+            let t = m.topic.as_str();
+            let wire = match index.get(t) {
+                Some(&k) => k,
+                None => {
+                    plan.wires.push(match payload {
+                        Payload::Inflow(_) => {
+                            Wire::Inflow(publisher(node, ros, t, topics::INFLOW_QOS)?)
+                        }
+                        Payload::Level(_) => {
+                            Wire::Level(publisher(node, ros, t, topics::GAUGE_QOS)?)
+                        }
+                        Payload::Range(_) => {
+                            Wire::Range(publisher(node, ros, t, topics::GAUGE_QOS)?)
+                        }
+                    });
+                    println!("playing {t} as {}", full_topic("/", ros, t));
+                    index.insert(t, plan.wires.len() - 1);
+                    plan.wires.len() - 1
+                }
+            };
+            plan.due.push(Due {
+                wire,
+                at_s,
+                payload,
+            });
+        }
+        Ok(plan)
+    }
+
+    /// The last sample's log time, s since the epoch (`start_s` with none).
+    fn last_s(&self, start_s: f64) -> f64 {
+        self.due.last().map_or(start_s, |d| d.at_s)
+    }
+
+    /// Publishes sample `d` on its topic, logging what could not be sent.
+    fn send(&self, d: &Due) {
+        let r = match (&self.wires[d.wire], &d.payload) {
+            (Wire::Inflow(p), Payload::Inflow(m)) => p.publish(m.clone()).map_err(drop),
+            (Wire::Level(p), Payload::Level(m)) => p.publish(m.clone()).map_err(drop),
+            (Wire::Range(p), Payload::Range(m)) => p.publish(m.clone()).map_err(drop),
+            _ => {
+                log::warn!(
+                    "a sample logged at {:.3} s has another type than its topic's first: not sent",
+                    d.at_s
+                );
+                Ok(())
             }
         };
-        let period = Duration::from_secs_f64(1.0 / args.clock_hz);
+        if r.is_err() {
+            log::warn!("a sample logged at {:.3} s could not be sent", d.at_s);
+        }
+    }
+}
+
+/// The player's clock: `/clock` every `period` of wall time, the recording's time running
+/// `rate` times as fast as the wall's from `start_s` (s since the epoch).
+struct Player {
+    clock: Publisher<Clock>,
+    period: Duration,
+    rate: f64,
+    start_s: f64,
+}
+
+impl Player {
+    fn send_clock(&self, t: f64) {
+        let stamp = Time::from_secs_f64(t).unwrap_or_default();
+        if let Err(e) = self.clock.publish(Clock { clock: stamp }) {
+            log::warn!("/clock could not be sent: {e:?}");
+        }
+    }
+
+    /// Holds the clock at the start for `delay_s`, then plays the plan to its end, Ctrl-C or
+    /// SIGTERM.
+    async fn play(&self, plan: &Plan, delay_s: f64) -> Result<()> {
         let mut shutdown = Box::pin(tokio::signal::ctrl_c());
         let mut terminate =
             tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
                 .context("cannot watch for SIGTERM")?;
         let held = Instant::now();
-        while held.elapsed().as_secs_f64() < args.delay_s.max(0.0) {
-            send_clock(start_s);
+        while held.elapsed().as_secs_f64() < delay_s.max(0.0) {
+            self.send_clock(self.start_s);
             tokio::select! {
-                _ = tokio::time::sleep(period) => {}
+                _ = tokio::time::sleep(self.period) => {}
                 _ = &mut shutdown => return Ok(()),
                 _ = terminate.recv() => return Ok(()),
             }
         }
+        let (start_s, last_s) = (self.start_s, plan.last_s(self.start_s));
         let started = Instant::now();
         let mut next_clock = started;
         let (mut sent, mut clocks) = (0usize, 0u64);
-        while sent < plan.len() {
-            let now_s = (start_s + started.elapsed().as_secs_f64() * rate).min(last_s);
-            let due = plan.get(sent).is_some_and(|d| d.at_s <= now_s);
+        while sent < plan.due.len() {
+            let now_s = (start_s + started.elapsed().as_secs_f64() * self.rate).min(last_s);
+            let due = plan.due.get(sent).is_some_and(|d| d.at_s <= now_s);
             if due || Instant::now() >= next_clock {
-                send_clock(now_s);
+                self.send_clock(now_s);
                 clocks += 1;
                 // After a stall the clock goes on from now rather than catching up in a burst.
-                next_clock = (next_clock + period).max(Instant::now());
+                next_clock = (next_clock + self.period).max(Instant::now());
             }
-            while let Some(d) = plan.get(sent).filter(|d| d.at_s <= now_s) {
-                let r = match (&wires[d.wire], &d.payload) {
-                    (Wire::Inflow(p), Payload::Inflow(m)) => p.publish(m.clone()).map_err(drop),
-                    (Wire::Level(p), Payload::Level(m)) => p.publish(m.clone()).map_err(drop),
-                    (Wire::Range(p), Payload::Range(m)) => p.publish(m.clone()).map_err(drop),
-                    _ => {
-                        log::warn!(
-                            "a sample logged at {:.3} s has another type than its topic's first: not sent",
-                            d.at_s
-                        );
-                        Ok(())
-                    }
-                };
-                if r.is_err() {
-                    log::warn!("a sample logged at {:.3} s could not be sent", d.at_s);
-                }
+            while let Some(d) = plan.due.get(sent).filter(|d| d.at_s <= now_s) {
+                plan.send(d);
                 sent += 1;
             }
-            let next_sample = plan.get(sent).map_or(next_clock, |d| {
-                started + Duration::from_secs_f64((d.at_s - start_s) / rate)
+            let next_sample = plan.due.get(sent).map_or(next_clock, |d| {
+                started + Duration::from_secs_f64((d.at_s - start_s) / self.rate)
             });
             tokio::select! {
                 _ = tokio::time::sleep_until(next_clock.min(next_sample).into()) => {}
@@ -271,14 +331,15 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
                 }
             }
         }
-        send_clock(last_s);
+        self.send_clock(last_s);
         let wall = started.elapsed().as_secs_f64();
         // Reliable samples still in flight get their chance before the writers go.
         tokio::time::sleep(Duration::from_millis(200)).await;
         println!(
-            "played {sent} samples and {} /clock messages in {wall:.3} s; undecodable: {undecodable}",
+            "played {sent} samples and {} /clock messages in {wall:.3} s; undecodable: {}",
             clocks + 1,
+            plan.undecodable,
         );
         Ok(())
-    })
+    }
 }

@@ -19,7 +19,7 @@ use crate::twin::gate::Limits;
 use crate::twin::messages::Outputs;
 use crate::twin::samples::Input;
 use crate::twin::settings::{Settings, mount_heights};
-use crate::twin::solver_thread::{self, ChunkSinks, Report};
+use crate::twin::solver_thread::{self, ChunkSinks, Report, SolverLink};
 use crate::twin::{Options, Twin, gauge_names};
 use anyhow::{Context, Result, anyhow, bail};
 use flume_msgs::RosMessage;
@@ -44,6 +44,18 @@ struct OutputBag {
 }
 
 impl OutputBag {
+    /// Writes the feed's inputs from `written` on (those the run did not reach) and closes
+    /// the bag.
+    fn finish_with(mut self, feed: &Feed, written: usize) -> Result<()> {
+        for &(k, _) in &feed.events[written..] {
+            self.input(feed.messages[k].0)?;
+        }
+        let path = self.bag.path().to_path_buf();
+        self.bag.finish()?;
+        println!("wrote {}", path.display());
+        Ok(())
+    }
+
     fn create(path: &std::path::Path) -> Result<OutputBag> {
         let mut bag = BagWriter::create(path, None)?;
         let abs = |t: &str| format!("/{}", t.trim_start_matches('/'));
@@ -105,16 +117,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
             "an in-process replay matches topics by their last segments: remaps are ignored"
         );
     }
-    let Some(config) = &args.config else {
-        bail!("--config CASE is needed to replay through the twin");
-    };
-    let case = Case::from_path_with(config, &args.set).context("the case file was refused")?;
-    if case.open_flume.is_none() {
-        bail!(
-            "{}: the twin needs an open flume for the recorded inflow to drive",
-            config.display()
-        );
-    }
+    let case = replayed_case(args)?;
     let recording = BagFile::read(&args.recording)?;
     if let Some(damage) = &recording.damage {
         log::warn!("{damage}; replaying what comes before it");
@@ -141,25 +144,8 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         "adapter: {}\nparticles: {}",
         solver.link.adapter, solver.link.particles
     );
-    let options = Options {
-        gauge_names: gauge_names.clone(),
-        node_name: "flume_twin".into(),
-        wait_for_sensors: true,
-        max_chunk_s: args.output_interval_s,
-        until: None,
-        cloud_rate_hz: 0.0,
-        cloud_max_points: 0,
-    };
     let settings = Settings::for_replay(&gauge_names, mount_height_m, args.stale_after_s);
-    let mut twin = Twin::new(options, limits, settings, solver.link);
-    twin.start_at(feed.origin);
-    if let Some(q) = feed.carried {
-        twin.hold_inflow(q);
-    }
-    // Every sample is judged at its log time, as a live twin would have judged it.
-    for &(k, input) in &feed.events {
-        twin.sample_at(input, feed.messages[k].0.log_ns as f64 * 1e-9);
-    }
+    let mut twin = fed_twin(args, &feed, gauge_names, (limits, settings), solver.link);
     let mut out = args.out.as_deref().map(OutputBag::create).transpose()?;
     // The plots go beside the CSV files they draw.
     let mut plots = args.csv.as_ref().map(|_| SeriesPlots::compared());
@@ -181,13 +167,8 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         log::warn!("the solver thread panicked");
     }
     let wall = started.elapsed().as_secs_f64();
-    if let Some(mut out) = out {
-        for &(k, _) in &feed.events[ran.inputs_written..] {
-            out.input(feed.messages[k].0)?;
-        }
-        let path = out.bag.path().to_path_buf();
-        out.bag.finish()?;
-        println!("wrote {}", path.display());
+    if let Some(out) = out {
+        out.finish_with(&feed, ran.inputs_written)?;
     }
     if let (Some(plots), Some(dir)) = (&plots, &args.csv) {
         for path in plots.draw(dir, &case_name)? {
@@ -209,6 +190,50 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         feed.undecodable
     );
     Ok(())
+}
+
+/// The case `--config` names with its `--set`s, which must have an open flume.
+fn replayed_case(args: &ReplayArgs) -> Result<Case> {
+    let Some(config) = &args.config else {
+        bail!("--config CASE is needed to replay through the twin");
+    };
+    let case = Case::from_path_with(config, &args.set).context("the case file was refused")?;
+    if case.open_flume.is_none() {
+        bail!(
+            "{}: the twin needs an open flume for the recorded inflow to drive",
+            config.display()
+        );
+    }
+    Ok(case)
+}
+
+/// A twin on the solver `link`, started at the feed's origin and given every sample at its
+/// log time, as a live twin would have judged it.
+fn fed_twin(
+    args: &ReplayArgs,
+    feed: &Feed,
+    gauge_names: Vec<String>,
+    (limits, settings): (Limits, Settings),
+    link: SolverLink,
+) -> Twin {
+    let options = Options {
+        gauge_names,
+        node_name: "flume_twin".into(),
+        wait_for_sensors: true,
+        max_chunk_s: args.output_interval_s,
+        until: None,
+        cloud_rate_hz: 0.0,
+        cloud_max_points: 0,
+    };
+    let mut twin = Twin::new(options, limits, settings, link);
+    twin.start_at(feed.origin);
+    if let Some(q) = feed.carried {
+        twin.hold_inflow(q);
+    }
+    for &(k, input) in &feed.events {
+        twin.sample_at(input, feed.messages[k].0.log_ns as f64 * 1e-9);
+    }
+    twin
 }
 
 /// A recording's sensor samples as a replay takes them.

@@ -10,7 +10,7 @@ use crate::adapters::bag::samples::{decode, role};
 use crate::adapters::bag::tap::{Outlet, Tap, input_channels};
 use crate::adapters::files::outputs::recorder_in;
 use crate::adapters::files::series_plot::SeriesPlots;
-use crate::adapters::foxglove::LiveView;
+use crate::adapters::foxglove::{LiveView, ViewOptions};
 use crate::adapters::frames::frames_on;
 use crate::adapters::ros::args::RosArgs;
 use crate::adapters::ros::parameters::{ParameterServices, ParameterStream, live_parameters};
@@ -100,7 +100,12 @@ async fn serve(
     let use_sim_time = settings.use_sim_time;
     let sensors = Sensors::subscribe(&mut node, &full, &gauge_names, args.gauge_msg, use_sim_time)?;
     let mut tap = tap(args, &full, &gauge_names)?;
-    let view = LiveView::for_node(args, &full, &gauge_names).await?;
+    let view_options = ViewOptions {
+        port: args.foxglove,
+        loopback: args.loopback,
+        gauge_ranges: args.gauge_msg == GaugeMsg::Range,
+    };
+    let view = LiveView::for_node(&view_options, &full, &gauge_names).await?;
     let outlets = Outlets::create(&mut node, &mut tap, &view, &full, use_sim_time)?;
     let node_path = format!("{}/{node_name}", namespace.trim_end_matches('/'));
     let servers = services(&mut node, &node_path)?;
@@ -145,14 +150,25 @@ async fn serve(
     drive(&mut twin, &mut wire).await?;
     // Closing the solver's channel: it finishes its chunk and stops.
     drop(twin);
+    wind_down(wire, solver.handle, args.out.clone(), case_name).await
+}
+
+/// Closes the recording and the viewer, waits for the solver thread, and draws the plots
+/// into `out`.
+async fn wind_down(
+    mut wire: Wire<'_>,
+    solver: std::thread::JoinHandle<()>,
+    out: Option<PathBuf>,
+    case_name: String,
+) -> Result<()> {
     wire.tap.finish()?;
     wire.view.stop().await;
     // Waiting for it is blocking work: off the async runtime's threads.
-    let joined = tokio::task::spawn_blocking(move || solver.handle.join()).await;
+    let joined = tokio::task::spawn_blocking(move || solver.join()).await;
     if !matches!(joined, Ok(Ok(()))) {
         log::warn!("the solver thread panicked");
     }
-    if let (Some(plots), Some(dir)) = (wire.plots.take(), args.out.clone()) {
+    if let (Some(plots), Some(dir)) = (wire.plots.take(), out) {
         // Drawing and encoding PNGs is blocking work too.
         let drawn = tokio::task::spawn_blocking(move || plots.draw(&dir, &case_name))
             .await

@@ -26,27 +26,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     // The case is checked before the GPU is opened, so a bad file fails fast and on any machine.
     let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
     flume_solver::check_inflow(&case).context("the case file was refused")?;
-    let end_s = match args.until {
-        Some(t) if !(t.is_finite() && t > 0.0) => {
-            bail!("--until must be a positive time in s, got {t}")
-        }
-        Some(t) => t,
-        None => case.time.end_s,
-    };
+    let (end_s, inflow) = end_and_inflow(args, &case)?;
     let out_dir = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&case.name));
     let snapshot_every = (!args.no_snapshots).then_some(args.snapshot_every);
-    let inflow = match &args.inflow {
-        None => None,
-        Some(path) if case.open_flume.is_none() => bail!(
-            "--inflow {}: the case {} has no open_flume to feed",
-            path.display(),
-            case.name
-        ),
-        Some(path) => Some(InflowSeries::from_path(path)?),
-    };
 
     let backend = Backend::choose().context("cannot open a backend")?;
     let mut sim = Simulation::new(backend, &case).context("cannot set up the simulation")?;
@@ -83,14 +68,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let target_s = (k as f64 * interval_s).min(end_s);
         if let Err(err) = advance(&mut sim, inflow.as_ref(), target_s) {
             bar.abandon();
-            if let Some(SolverError::BlowUp { culprits, .. }) = err.downcast_ref::<SolverError>() {
-                // The broken state shows where it went wrong; losing it would waste the run.
-                // Its `culprit` field marks the particles the error names.
-                let ids: Vec<u32> = culprits.iter().map(|c| c.id).collect();
-                if let Err(e) = recorder.snapshot_marked(&sim, "particles_failed.vtk", &ids) {
-                    log::warn!("could not write the failed state: {e:#}");
-                }
-            }
+            save_failed_state(&err, &recorder, &sim);
             return Err(err.context(format!(
                 "the simulation stopped; outputs up to t = {} s are in {}",
                 last.time_s,
@@ -122,15 +100,60 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             println!("bed plot: none, no profile column held sediment");
         }
     }
-    for path in plots.draw(&out_dir, &case.name)? {
+    draw_series(&out_dir, &case.name, &plots, &recorder)?;
+    print_summary(&sim, &last, wall_s);
+    Ok(())
+}
+
+/// The run's end (`--until`, or the case's) and the inflow series `--inflow` reads, refused
+/// for a case with no open flume.
+fn end_and_inflow(args: &SimulateArgs, case: &Case) -> Result<(f64, Option<InflowSeries>)> {
+    let end_s = match args.until {
+        Some(t) if !(t.is_finite() && t > 0.0) => {
+            bail!("--until must be a positive time in s, got {t}")
+        }
+        Some(t) => t,
+        None => case.time.end_s,
+    };
+    let inflow = match &args.inflow {
+        None => None,
+        Some(path) if case.open_flume.is_none() => bail!(
+            "--inflow {}: the case {} has no open_flume to feed",
+            path.display(),
+            case.name
+        ),
+        Some(path) => Some(InflowSeries::from_path(path)?),
+    };
+    Ok((end_s, inflow))
+}
+
+/// With a blow-up, writes the broken state, which shows where it went wrong (losing it would
+/// waste the run); its `culprit` field marks the particles the error names.
+fn save_failed_state(err: &anyhow::Error, recorder: &OutputFiles, sim: &Simulation) {
+    if let Some(SolverError::BlowUp { culprits, .. }) = err.downcast_ref::<SolverError>() {
+        let ids: Vec<u32> = culprits.iter().map(|c| c.id).collect();
+        if let Err(e) = recorder.snapshot_marked(sim, "particles_failed.vtk", &ids) {
+            log::warn!("could not write the failed state: {e:#}");
+        }
+    }
+}
+
+/// Draws the gauges' and the eroded mass's series, and the sediment budget where it has more
+/// than one row.
+fn draw_series(
+    out_dir: &Path,
+    case_name: &str,
+    plots: &SeriesPlots,
+    recorder: &OutputFiles,
+) -> Result<()> {
+    for path in plots.draw(out_dir, case_name)? {
         println!("plot: {}", path.display());
     }
     if recorder.budget_rows().len() > 1 {
         let path = out_dir.join("sediment_budget.png");
-        budget_plot::draw(&path, &case.name, recorder.budget_rows())?;
+        budget_plot::draw(&path, case_name, recorder.budget_rows())?;
         println!("plot: {}", path.display());
     }
-    print_summary(&sim, &last, wall_s);
     Ok(())
 }
 
