@@ -68,6 +68,188 @@ fn held_here(i: u32) -> bool {
 // The corrector's half-step forces do not set the step: only the predictor's do (DualSPHysics).
 override REDUCE_DT: bool = true;
 
+// Particle i as its neighbour sums read it: position (phase in w), velocity, density, phase,
+// whether it moves (held sand standing as a wall does not), its momentum pressure over rho^2,
+// rest density, Tait coefficient, viscosity and stress over rho^2; whether held sand is a wall
+// and the reach of its contact force, squared.
+struct Own {
+    pos: vec4<f32>,
+    vel: vec3<f32>,
+    rho: f32,
+    phase: u32,
+    mobile: bool,
+    press: f32,
+    rho0: f32,
+    b: f32,
+    mu: f32,
+    tau: mat3x3<f32>,
+    bed_walls: bool,
+    bed_r0_2: f32,
+}
+
+fn own(i: u32) -> Own {
+    var o: Own;
+    o.pos = textureLoad(positions, texel(i), 0);
+    let vr = textureLoad(vel_rho, texel(i), 0);
+    o.vel = vr.xyz;
+    o.rho = vr.w;
+    o.phase = bitcast<u32>(o.pos.w);
+    // Held sediment may stand as a wall (cpu/step.rs, bed_is_boundary).
+    o.bed_walls = held_bed_is_wall();
+    if (o.bed_walls) {
+        o.bed_r0_2 = bed_contact_r0_2();
+    }
+    o.mobile = params.phases[o.phase].mobile > 0.5 && !(o.bed_walls && held_here(i));
+    o.press = momentum_pressure(o.rho, o.phase) / (o.rho * o.rho);
+    o.rho0 = params.phases[o.phase].rho0;
+    o.b = params.tait_b[o.phase];
+    o.mu = params.phases[o.phase].mu;
+    if (params.viscosity_mode == VISCOSITY_MULTIPHASE && o.mobile) {
+        o.tau = stress_over_rho2(i, o.rho);
+    }
+    return o;
+}
+
+// What particle i gathers from its neighbours: acceleration, density rate, the largest
+// |mu_ij|, and a wall's sums of the generalised wall condition (physics/boundary.rs).
+struct Sums {
+    acc: vec3<f32>,
+    drho: f32,
+    visc_max: f32,
+    wall_w: f32,
+    wall_pw: f32,
+    wall_rho_r: vec3<f32>,
+}
+
+// Neighbour j as particle i sees it: its phase, whether it moves, the offset and velocity
+// difference (i minus j), r^2, the kernel's gradient factor, the mass and density (a wall's
+// scaled to i's phase), its momentum pressure over rho^2, v.r and the viscous mu_ij of
+// Monaghan's term.
+struct Neighbour {
+    j: u32,
+    phase: u32,
+    mobile: bool,
+    dx: vec3<f32>,
+    dv: vec3<f32>,
+    r2: f32,
+    f: f32,
+    m: f32,
+    rho: f32,
+    press: f32,
+    vdotr: f32,
+    mu_ij: f32,
+}
+
+// Density diffusion's rate from a neighbour of i's phase, `dz` above it (Fourtakas et al.'s
+// hydrostatic correction in mode 2).
+fn diffusion_rate(o: Own, n: Neighbour, dz: f32) -> f32 {
+    var rho_h = 0.0;
+    if (params.diffusion_mode == 2u) {
+        // (1 + x)^(1/7) - 1 by its series: x = 7 g dz / c0^2 is below 1e-3 for neighbours
+        // (dz < 2h), where three terms are exact in f32; pow is not cheap.
+        let x = o.rho0 * params.gravity.w * dz / o.b;
+        rho_h = o.rho0 * x * (1.0 / 7.0 + x * (-3.0 / 49.0 + x * (13.0 / 343.0)));
+    }
+    return params.delta_h_c0 * 2.0 * (n.rho - o.rho - rho_h) * (-n.r2 * n.f) / (n.r2 + params.eta2) * (n.m / n.rho);
+}
+
+// The pressure and viscous acceleration of mobile particle i from neighbour n.
+fn pair_acc(o: Own, n: Neighbour) -> vec3<f32> {
+    var coef = -n.m * (o.press + n.press);
+    if (params.viscosity_mode == 0u || params.viscosity_mode == VISCOSITY_MULTIPHASE) {
+        if (n.vdotr < 0.0) {
+            let pi_ij = -params.alpha * params.c0 * n.mu_ij / (0.5 * (o.rho + n.rho));
+            coef -= n.m * pi_ij;
+        }
+    }
+    if (params.viscosity_mode == 0u) {
+        return coef * n.f * n.dx;
+    }
+    if (params.viscosity_mode == VISCOSITY_MULTIPHASE) {
+        var tau = o.tau;
+        if (n.mobile) {
+            tau += stress_over_rho2(n.j, n.rho);
+        }
+        return coef * n.f * n.dx + (n.m * n.f) * (tau * n.dx);
+    }
+    let mu_j = params.phases[n.phase].mu;
+    return coef * n.f * n.dx + (n.m * (o.mu + mu_j) * (n.r2 * n.f) / (o.rho * n.rho * (n.r2 + params.eta2))) * n.dv;
+}
+
+// Adds neighbour j (sorted order) to particle i's sums.
+fn add_neighbour(sums: ptr<function, Sums>, o: Own, j: u32) {
+    let h = params.h;
+    let pos_j = textureLoad(positions, texel(j), 0);
+    var n: Neighbour;
+    n.j = j;
+    n.dx = o.pos.xyz - pos_j.xyz;
+    n.r2 = dot(n.dx, n.dx);
+    if (n.r2 >= 4.0 * h * h || n.r2 < 1e-12 * h * h) {
+        return;
+    }
+    n.phase = bitcast<u32>(pos_j.w);
+    n.mobile = params.phases[n.phase].mobile > 0.5 && !(o.bed_walls && held_here(j));
+    if (!o.mobile && !n.mobile) {
+        return;
+    }
+    let vr_j = textureLoad(vel_rho, texel(j), 0);
+    n.dv = o.vel - vr_j.xyz;
+    n.f = kernel_grad_factor(sqrt(n.r2));
+    // A wall seen from a fluid particle stands in for that fluid (`wall_scale` in
+    // interaction.rs): its mass and density scaled by the ratio of rest densities.
+    var scale = 1.0;
+    if (o.mobile && !n.mobile) {
+        scale = o.rho0 / params.phases[n.phase].rho0;
+    }
+    n.m = params.phases[n.phase].mass * scale;
+    n.rho = vr_j.w * scale;
+    n.vdotr = dot(n.dv, n.dx);
+    (*sums).drho += n.m * n.vdotr * n.f;
+    if (!o.mobile) {
+        if (params.boundary_mode == BOUNDARY_GENERALISED && !velocity_imposed(pos_j.xyz, n.phase)) {
+            let w = kernel_w(sqrt(n.r2));
+            (*sums).wall_w += w;
+            (*sums).wall_pw += momentum_pressure(vr_j.w, n.phase) * w;
+            (*sums).wall_rho_r += vr_j.w * n.dx * w;
+        }
+        return;
+    }
+    // Only held sand is a wall of a mobile phase.
+    if (o.bed_walls && !n.mobile && params.phases[n.phase].mobile > 0.5 && n.phase != o.phase) {
+        (*sums).acc += bed_contact(n.r2, o.bed_r0_2) * n.dx;
+    }
+    if (params.diffusion_mode != 0u && n.mobile && n.phase == o.phase) {
+        let dz = o.pos[params.vertical_axis] - pos_j[params.vertical_axis];
+        (*sums).drho += diffusion_rate(o, n, dz);
+    }
+    n.press = momentum_pressure(vr_j.w, n.phase) / (n.rho * n.rho);
+    n.mu_ij = h * n.vdotr / (n.r2 + params.eta2);
+    (*sums).visc_max = max((*sums).visc_max, abs(n.mu_ij));
+    (*sums).acc += pair_acc(o, n);
+}
+
+// A wall's density under the generalised condition: that of the fluid's pressure around it,
+// rest density with no fluid near.
+fn generalised_wall_density(sums: Sums, rho0: f32, b: f32) -> f32 {
+    if (sums.wall_w <= 0.0) {
+        return rho0;
+    }
+    let p = (sums.wall_pw + dot(params.gravity.xyz, sums.wall_rho_r)) / sums.wall_w;
+    return rho0 * pow(max(1.0 + p / b, 0.0), 1.0 / 7.0);
+}
+
+// Mobile particle i's stable step from its acceleration and largest mu_ij, and in the
+// multiphase mode its own apparent viscosity's explicit limit.
+fn particle_step(i: u32, o: Own, acc: vec3<f32>, visc_max: f32) -> f32 {
+    let force_bound = !velocity_imposed(o.pos.xyz, o.phase);
+    var dt_i = stable_step(params.h, params.c0, length(acc), force_bound, visc_max);
+    if (params.viscosity_mode == VISCOSITY_MULTIPHASE) {
+        let mu_app = textureLoad(stress_b, texel(i), 0).z;
+        dt_i = min(dt_i, viscous_step(params.h, o.rho, mu_app));
+    }
+    return dt_i;
+}
+
 @compute @workgroup_size(64)
 fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -76,138 +258,24 @@ fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= cell_starts[params.n_cells] || chunk_idle(REDUCE_DT)) {
         return;
     }
-    let pos_i = textureLoad(positions, texel(i), 0);
-    let vr_i = textureLoad(vel_rho, texel(i), 0);
-    let phase_i = bitcast<u32>(pos_i.w);
-    // Held sediment may stand as a wall (cpu/step.rs, bed_is_boundary).
-    let bed_walls = held_bed_is_wall();
-    var bed_r0_2 = 0.0;
-    if (bed_walls) {
-        bed_r0_2 = bed_contact_r0_2();
-    }
-    let mobile_i = params.phases[phase_i].mobile > 0.5 && !(bed_walls && held_here(i));
-    let rho_i = vr_i.w;
-    let press_i = momentum_pressure(rho_i, phase_i) / (rho_i * rho_i);
-    let h = params.h;
-    let four_h2 = 4.0 * h * h;
-    let r2_min = 1e-12 * h * h;
-    let vert = params.vertical_axis;
-    let g_vert = params.gravity.w;
-    let rho0_i = params.phases[phase_i].rho0;
-    let b_i = params.tait_b[phase_i];
-    let mu_i = params.phases[phase_i].mu;
-    let multiphase = params.viscosity_mode == VISCOSITY_MULTIPHASE;
-    var tau_i = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    if (multiphase && mobile_i) {
-        tau_i = stress_over_rho2(i, rho_i);
-    }
-
-    var acc = vec3<f32>(0.0);
-    var drho = 0.0;
-    var visc_max = 0.0;
-    // A wall's sums of the generalised wall condition (physics/boundary.rs).
-    let generalised = params.boundary_mode == BOUNDARY_GENERALISED;
-    var wall_w = 0.0;
-    var wall_pw = 0.0;
-    var wall_rho_r = vec3<f32>(0.0);
-    let cell = cell_coords(pos_i.xyz);
+    let o = own(i);
+    var sums: Sums;
+    let cell = cell_coords(o.pos.xyz);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
         for (var j = range.x; j < range.y; j++) {
-            let pos_j = textureLoad(positions, texel(j), 0);
-            let dx = pos_i.xyz - pos_j.xyz;
-            let r2 = dot(dx, dx);
-            if (r2 >= four_h2 || r2 < r2_min) {
-                continue;
-            }
-            let phase_j = bitcast<u32>(pos_j.w);
-            let mobile_j = params.phases[phase_j].mobile > 0.5 && !(bed_walls && held_here(j));
-            if (!mobile_i && !mobile_j) {
-                continue;
-            }
-            let vr_j = textureLoad(vel_rho, texel(j), 0);
-            let dv = vr_i.xyz - vr_j.xyz;
-            let f = kernel_grad_factor(sqrt(r2));
-            // A wall seen from a fluid particle stands in for that fluid (`wall_scale` in
-            // interaction.rs): its mass and density scaled by the ratio of rest densities.
-            var scale = 1.0;
-            if (mobile_i && !mobile_j) {
-                scale = rho0_i / params.phases[phase_j].rho0;
-            }
-            let m_j = params.phases[phase_j].mass * scale;
-            let rho_j = vr_j.w * scale;
-            let vdotr = dot(dv, dx);
-            drho += m_j * vdotr * f;
-            if (!mobile_i) {
-                if (generalised && !velocity_imposed(pos_j.xyz, phase_j)) {
-                    let w = kernel_w(sqrt(r2));
-                    wall_w += w;
-                    wall_pw += momentum_pressure(vr_j.w, phase_j) * w;
-                    wall_rho_r += vr_j.w * dx * w;
-                }
-                continue;
-            }
-            // Only held sand is a wall of a mobile phase.
-            if (bed_walls && !mobile_j && params.phases[phase_j].mobile > 0.5 && phase_j != phase_i) {
-                acc += bed_contact(r2, bed_r0_2) * dx;
-            }
-            if (params.diffusion_mode != 0u && mobile_j && phase_j == phase_i) {
-                var rho_h = 0.0;
-                if (params.diffusion_mode == 2u) {
-                    let dz = pos_i[vert] - pos_j[vert];
-                    // (1 + x)^(1/7) - 1 by its series: x = 7 g dz / c0^2 is below 1e-3 for
-                    // neighbours (dz < 2h), where three terms are exact in f32; pow is not cheap.
-                    let x = rho0_i * g_vert * dz / b_i;
-                    rho_h = rho0_i * x * (1.0 / 7.0 + x * (-3.0 / 49.0 + x * (13.0 / 343.0)));
-                }
-                drho += params.delta_h_c0 * 2.0 * (rho_j - rho_i - rho_h) * (-r2 * f) / (r2 + params.eta2) * (m_j / rho_j);
-            }
-            let press_j = momentum_pressure(vr_j.w, phase_j) / (rho_j * rho_j);
-            var coef = -m_j * (press_i + press_j);
-            let mu_ij = h * vdotr / (r2 + params.eta2);
-            visc_max = max(visc_max, abs(mu_ij));
-            if (params.viscosity_mode == 0u) {
-                if (vdotr < 0.0) {
-                    let pi_ij = -params.alpha * params.c0 * mu_ij / (0.5 * (rho_i + rho_j));
-                    coef -= m_j * pi_ij;
-                }
-                acc += coef * f * dx;
-            } else if (multiphase) {
-                if (vdotr < 0.0) {
-                    let pi_ij = -params.alpha * params.c0 * mu_ij / (0.5 * (rho_i + rho_j));
-                    coef -= m_j * pi_ij;
-                }
-                var tau = tau_i;
-                if (mobile_j) {
-                    tau += stress_over_rho2(j, rho_j);
-                }
-                acc += coef * f * dx + (m_j * f) * (tau * dx);
-            } else {
-                let mu_j = params.phases[phase_j].mu;
-                acc += coef * f * dx + (m_j * (mu_i + mu_j) * (r2 * f) / (rho_i * rho_j * (r2 + params.eta2))) * dv;
-            }
+            add_neighbour(&sums, o, j);
         }
     }
     var dt_i = 3.0e38;
-    if (mobile_i) {
-        acc += params.gravity.xyz;
-        let force_bound = !velocity_imposed(pos_i.xyz, phase_i);
-        dt_i = stable_step(h, params.c0, length(acc), force_bound, visc_max);
-        if (multiphase) {
-            // The explicit viscous limit with the particle's own apparent viscosity.
-            let mu_app = textureLoad(stress_b, texel(i), 0).z;
-            dt_i = min(dt_i, viscous_step(h, rho_i, mu_app));
-        }
-    } else {
-        acc = vec3<f32>(0.0);
-        if (generalised) {
-            // The wall's density in place of its rate: that of the fluid's pressure around it.
-            drho = rho0_i;
-            if (wall_w > 0.0) {
-                let p = (wall_pw + dot(params.gravity.xyz, wall_rho_r)) / wall_w;
-                drho = rho0_i * pow(max(1.0 + p / b_i, 0.0), 1.0 / 7.0);
-            }
-        }
+    var acc = vec3<f32>(0.0);
+    var drho = sums.drho;
+    if (o.mobile) {
+        acc = sums.acc + params.gravity.xyz;
+        dt_i = particle_step(i, o, acc, sums.visc_max);
+    } else if (params.boundary_mode == BOUNDARY_GENERALISED) {
+        // The wall's density in place of its rate.
+        drho = generalised_wall_density(sums, o.rho0, o.b);
     }
     forces[i] = vec4<f32>(acc, drho);
     if (REDUCE_DT) {

@@ -20,6 +20,118 @@
 // the way the force pass that follows it does.
 override BEFORE_DT: bool = true;
 
+// What the rheology pass gathers over particle i's neighbours: the velocity gradient
+// (grad[b] is the column du/dx_b), and for sediment the volumes of sediment and of the
+// mixture, the kernel-weighted sediment mass of the surface test, the bed's normal, and the
+// nearest water particle's distance squared and velocity relative to i.
+struct Gathered {
+    grad: mat3x3<f32>,
+    sediment_volume: f32,
+    mixture_volume: f32,
+    kernel_mass: f32,
+    normal: vec3<f32>,
+    nearest_r2: f32,
+    nearest_du: vec3<f32>,
+}
+
+// Adds neighbour j (sorted order) to the sums of particle i at pos_i moving at vel_i.
+fn gather_neighbour(g: ptr<function, Gathered>, pos_i: vec3<f32>, vel_i: vec3<f32>, is_sediment: bool, j: u32) {
+    let sd = params.sediment;
+    let pos_j = textureLoad(positions, texel(j), 0);
+    let dx = pos_i - pos_j.xyz;
+    let r2 = dot(dx, dx);
+    if (r2 >= 4.0 * params.h * params.h || r2 < 1e-12 * params.h * params.h) {
+        return;
+    }
+    let phase_j = bitcast<u32>(pos_j.w);
+    let vr_j = textureLoad(vel_rho, texel(j), 0);
+    let m_j = params.phases[phase_j].mass;
+    let v_j = m_j / vr_j.w;
+    let r = sqrt(r2);
+    let gw = dx * kernel_grad_factor(r);
+    let du = vr_j.xyz - vel_i;
+    (*g).grad += mat3x3<f32>(du * (v_j * gw.x), du * (v_j * gw.y), du * (v_j * gw.z));
+    if (!is_sediment) {
+        return;
+    }
+    // The bed's normal points away from the solid under it: sediment and walls.
+    if (phase_j == sd.phase || params.phases[phase_j].mobile < 0.5) {
+        (*g).normal -= v_j * gw;
+    }
+    if (phase_j == sd.phase) {
+        (*g).sediment_volume += v_j;
+        (*g).mixture_volume += v_j;
+        (*g).kernel_mass += m_j * kernel_w(r) * v_j;
+    } else if (phase_j == sd.water_phase) {
+        (*g).mixture_volume += v_j;
+        if (r2 < (*g).nearest_r2) {
+            (*g).nearest_r2 = r2;
+            (*g).nearest_du = du;
+        }
+    }
+}
+
+// The deviatoric strain rate of Eq. 12 from the velocity gradient, the trace correction 1/3
+// in 2-D too (see rheology.rs).
+fn deviatoric_strain(grad: mat3x3<f32>) -> mat3x3<f32> {
+    let dim_3d = params.vertical_axis == 2u;
+    let trace = grad[0].x + grad[1].y + select(0.0, grad[2].z, dim_3d);
+    var eps = 0.5 * (grad + transpose(grad));
+    eps[0].x -= trace / 3.0;
+    eps[1].y -= trace / 3.0;
+    if (dim_3d) {
+        eps[2].z -= trace / 3.0;
+    } else {
+        eps[2] = vec3<f32>(0.0);
+        eps[0].z = 0.0;
+        eps[1].z = 0.0;
+    }
+    return eps;
+}
+
+// A sediment particle's region and apparent viscosity.
+struct Chosen {
+    region: u32,
+    mu: f32,
+}
+
+// Sediment particle i's region and apparent viscosity from its sums, its density and II_D:
+// the Shields chain at the surface, the pick-up draw, Figure 2's region.
+fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
+    let sd = params.sediment;
+    let tau_y = drucker_prager_yield(rho_i);
+    let has_water = g.nearest_r2 < HUGE;
+    let at_surface = has_water && g.kernel_mass < sd.surface_mass;
+    var tau_b = 0.0;
+    var tau_bcr = HUGE;
+    if (at_surface) {
+        let u_star = friction_velocity(length(g.nearest_du), sqrt(g.nearest_r2), sd.ks, sd.nu_w);
+        let theta = critical_shields(u_star * sd.d50 / sd.nu_w);
+        let k = slope_factors(g.normal, g.nearest_du, sd.phi);
+        tau_b = sd.rho_w * u_star * u_star;
+        tau_bcr = k * theta * sd.submerged_weight * sd.d50;
+    }
+    let c_v = clamp(g.sediment_volume / g.mixture_volume, 0.0, 1.0);
+    // Read before this thread writes it; no other thread writes this id's word.
+    let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
+    // The stress the particle carries, which only the Drucker-Prager mode reads.
+    var sqrt_j2 = 0.0;
+    if (sd.shields_only == 0u) {
+        sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
+    }
+    // The pass before the step's size is chosen draws the pick-ups, one draw a step.
+    var picked = sd.pickup_per_s == 0.0;
+    if (!picked && BEFORE_DT) {
+        let step = state.run_steps + state.steps;
+        picked = picked_up(ids[i], step, pickup_rate(tau_b, tau_bcr), state.dt_taken);
+    }
+    let region = sediment_region(RegionInputs(
+        sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
+        picked
+    ));
+    return Chosen(region, region_viscosity(region, ii_d, tau_y, tau_bcr, c_v));
+}
+
 @compute @workgroup_size(64)
 fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -39,114 +151,32 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let sd = params.sediment;
     let is_sediment = phase_i == sd.phase && sd.phase != 0u;
-    let h = params.h;
-    let four_h2 = 4.0 * h * h;
-    let r2_min = 1e-12 * h * h;
     let rho_i = vr_i.w;
-
-    // grad[b] is the column du/dx_b.
-    var grad = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    var sediment_volume = 0.0;
-    var mixture_volume = 0.0;
-    var kernel_mass = 0.0;
-    var normal = vec3<f32>(0.0);
-    var nearest_r2 = HUGE;
-    var nearest_du = vec3<f32>(0.0);
+    var g: Gathered;
+    g.nearest_r2 = HUGE;
     if (is_sediment) {
         let v_i = ph_i.mass / rho_i;
-        sediment_volume = v_i;
-        mixture_volume = v_i;
-        kernel_mass = ph_i.mass * kernel_w(0.0) * v_i;
+        g.sediment_volume = v_i;
+        g.mixture_volume = v_i;
+        g.kernel_mass = ph_i.mass * kernel_w(0.0) * v_i;
     }
     let cell = cell_coords(pos_i.xyz);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
         for (var j = range.x; j < range.y; j++) {
-            let pos_j = textureLoad(positions, texel(j), 0);
-            let dx = pos_i.xyz - pos_j.xyz;
-            let r2 = dot(dx, dx);
-            if (r2 >= four_h2 || r2 < r2_min) {
-                continue;
-            }
-            let phase_j = bitcast<u32>(pos_j.w);
-            let vr_j = textureLoad(vel_rho, texel(j), 0);
-            let m_j = params.phases[phase_j].mass;
-            let v_j = m_j / vr_j.w;
-            let r = sqrt(r2);
-            let gw = dx * kernel_grad_factor(r);
-            let du = vr_j.xyz - vr_i.xyz;
-            grad += mat3x3<f32>(du * (v_j * gw.x), du * (v_j * gw.y), du * (v_j * gw.z));
-            if (!is_sediment) {
-                continue;
-            }
-            // The bed's normal points away from the solid under it: sediment and walls.
-            if (phase_j == sd.phase || params.phases[phase_j].mobile < 0.5) {
-                normal -= v_j * gw;
-            }
-            if (phase_j == sd.phase) {
-                sediment_volume += v_j;
-                mixture_volume += v_j;
-                kernel_mass += m_j * kernel_w(r) * v_j;
-            } else if (phase_j == sd.water_phase) {
-                mixture_volume += v_j;
-                if (r2 < nearest_r2) {
-                    nearest_r2 = r2;
-                    nearest_du = du;
-                }
-            }
+            gather_neighbour(&g, pos_i.xyz, vr_i.xyz, is_sediment, j);
         }
     }
-
-    // Eq. 12, the trace correction 1/3 in 2-D too (see rheology.rs).
-    let dim_3d = params.vertical_axis == 2u;
-    let trace = grad[0].x + grad[1].y + select(0.0, grad[2].z, dim_3d);
-    var eps = 0.5 * (grad + transpose(grad));
-    eps[0].x -= trace / 3.0;
-    eps[1].y -= trace / 3.0;
-    if (dim_3d) {
-        eps[2].z -= trace / 3.0;
-    } else {
-        eps[2] = vec3<f32>(0.0);
-        eps[0].z = 0.0;
-        eps[1].z = 0.0;
-    }
+    let eps = deviatoric_strain(g.grad);
     let ii_d = 0.5 * (dot(eps[0], eps[0]) + dot(eps[1], eps[1]) + dot(eps[2], eps[2]));
 
     // Water's own viscosity and its eddy viscosity; sediment takes its region's below.
     var mu = ph_i.mu + sps_viscosity(rho_i, ii_d);
     var region = REGION_WATER;
     if (is_sediment) {
-        let tau_y = drucker_prager_yield(rho_i);
-        let has_water = nearest_r2 < HUGE;
-        let at_surface = has_water && kernel_mass < sd.surface_mass;
-        var tau_b = 0.0;
-        var tau_bcr = HUGE;
-        if (at_surface) {
-            let u_star = friction_velocity(length(nearest_du), sqrt(nearest_r2), sd.ks, sd.nu_w);
-            let theta = critical_shields(u_star * sd.d50 / sd.nu_w);
-            let k = slope_factors(normal, nearest_du, sd.phi);
-            tau_b = sd.rho_w * u_star * u_star;
-            tau_bcr = k * theta * sd.submerged_weight * sd.d50;
-        }
-        let c_v = clamp(sediment_volume / mixture_volume, 0.0, 1.0);
-        // Read before this thread writes it; no other thread writes this id's word.
-        let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
-        // The stress the particle carries, which only the Drucker-Prager mode reads.
-        var sqrt_j2 = 0.0;
-        if (sd.shields_only == 0u) {
-            sqrt_j2 = 2.0 * min(hbp_viscosity(ii_d, tau_y), sd.mu_max) * sqrt(max(ii_d, 0.0));
-        }
-        // The pass before the step's size is chosen draws the pick-ups, one draw a step.
-        var picked = sd.pickup_per_s == 0.0;
-        if (!picked && BEFORE_DT) {
-            let step = state.run_steps + state.steps;
-            picked = picked_up(ids[i], step, pickup_rate(tau_b, tau_bcr), state.dt_taken);
-        }
-        region = sediment_region(RegionInputs(
-            sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
-            picked
-        ));
-        mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
+        let chosen = sediment_rheology(i, rho_i, g, ii_d);
+        region = chosen.region;
+        mu = chosen.mu;
     }
     // Shields-only holds carry no stress; Drucker-Prager holds keep theirs (hold.rs).
     let held = region == REGION_UNYIELDED;

@@ -167,6 +167,35 @@ impl Case {
         if !(n.cfl.is_finite() && n.cfl > 0.0 && n.cfl <= 1.0) {
             return err("numerics.cfl", format!("must be in (0, 1], got {}", n.cfl));
         }
+        self.validate_sound_speed()?;
+        match n.density_diffusion {
+            DensityDiffusion::MolteniColagrossi2009 { delta }
+            | DensityDiffusion::Fourtakas2019 { delta }
+                if !(delta.is_finite() && (0.0..=1.0).contains(&delta)) =>
+            {
+                return err(
+                    "numerics.density_diffusion.delta",
+                    format!("must be in 0..=1, got {delta}"),
+                );
+            }
+            _ => {}
+        }
+        self.validate_viscosity()?;
+        if let Integrator::Verlet { euler_every_steps } = n.integrator
+            && !(1..=1000).contains(&euler_every_steps)
+        {
+            return err(
+                "numerics.integrator.euler_every_steps",
+                format!("must be in 1..=1000, got {euler_every_steps}"),
+            );
+        }
+        Ok(())
+    }
+
+    /// The sound speed: exactly one of c0 and coefsound, positive.
+    fn validate_sound_speed(&self) -> Result<(), (String, String)> {
+        let err = |field: &str, reason: String| Err((field.to_string(), reason));
+        let n = &self.numerics;
         match (n.sound_speed.c0_m_per_s, n.sound_speed.coefsound) {
             (Some(c), None) if !(c.is_finite() && c > 0.0) => {
                 return err(
@@ -188,18 +217,14 @@ impl Case {
             }
             _ => {}
         }
-        match n.density_diffusion {
-            DensityDiffusion::MolteniColagrossi2009 { delta }
-            | DensityDiffusion::Fourtakas2019 { delta }
-                if !(delta.is_finite() && (0.0..=1.0).contains(&delta)) =>
-            {
-                return err(
-                    "numerics.density_diffusion.delta",
-                    format!("must be in 0..=1, got {delta}"),
-                );
-            }
-            _ => {}
-        }
+        Ok(())
+    }
+
+    /// The viscosity's parameters: Smagorinsky's constant, the eddy viscosity (given instead
+    /// of alpha), alpha.
+    fn validate_viscosity(&self) -> Result<(), (String, String)> {
+        let err = |field: &str, reason: String| Err((field.to_string(), reason));
+        let n = &self.numerics;
         if let Viscosity::Multiphase { smagorinsky_cs, .. } = n.viscosity
             && !(smagorinsky_cs.is_finite() && (0.0..=1.0).contains(&smagorinsky_cs))
         {
@@ -233,14 +258,6 @@ impl Case {
             return err(
                 "numerics.viscosity.alpha",
                 format!("must be in 0..=10, got {alpha}"),
-            );
-        }
-        if let Integrator::Verlet { euler_every_steps } = n.integrator
-            && !(1..=1000).contains(&euler_every_steps)
-        {
-            return err(
-                "numerics.integrator.euler_every_steps",
-                format!("must be in 1..=1000, got {euler_every_steps}"),
             );
         }
         Ok(())
@@ -428,6 +445,31 @@ impl Case {
                 "must be a box inside the flume (x_min < x_max, above the floor)".into(),
             );
         }
+        self.validate_outlet_and_sill(f)?;
+        // Sediment that starts in the collector would count as eroded at the first step.
+        if let Some((k, _)) = self.sediment_phases() {
+            let name = &self.phases[k].name;
+            for b in self.fluid_blocks.iter().filter(|b| &b.phase == name) {
+                if b.max_m[0] >= c.x_min_m && b.min_m[0] < c.x_max_m && b.min_m[1] < c.y_max_m {
+                    return err(
+                        "collector.x_min_m",
+                        format!(
+                            "the {name} block ending at x = {} m reaches into the collector",
+                            b.max_m[0]
+                        ),
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The open flume's bottom outlet and sill, where it has them.
+    fn validate_outlet_and_sill(&self, f: &OpenFlume) -> Result<(), (String, String)> {
+        let err = |name: &str, reason: String| Err((format!("open_flume.{name}"), reason));
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        let (lo, hi) = (&self.domain.min_m, &self.domain.max_m);
+        let dp = self.numerics.dp_m;
         if let Some(o) = &f.bottom_outlet {
             if !(o.x_min_m > lo[0] && o.x_min_m < hi[0]) {
                 return err("bottom_outlet.x_min_m", "must lie inside the flume".into());
@@ -460,21 +502,6 @@ impl Case {
                         "its crest stands a row under the bed's top, and a bed {top} m high has no row under its top at dp = {dp} m"
                     ),
                 );
-            }
-        }
-        // Sediment that starts in the collector would count as eroded at the first step.
-        if let Some((k, _)) = self.sediment_phases() {
-            let name = &self.phases[k].name;
-            for b in self.fluid_blocks.iter().filter(|b| &b.phase == name) {
-                if b.max_m[0] >= c.x_min_m && b.min_m[0] < c.x_max_m && b.min_m[1] < c.y_max_m {
-                    return err(
-                        "collector.x_min_m",
-                        format!(
-                            "the {name} block ending at x = {} m reaches into the collector",
-                            b.max_m[0]
-                        ),
-                    );
-                }
             }
         }
         Ok(())

@@ -35,47 +35,8 @@ pub fn sim_params(
         *gk = *v as f32;
     }
     gravity[3] = (-case.gravity_m_per_s2[d - 1]) as f32;
-    let mut phases = [PhaseParams {
-        rho0: 1000.0,
-        mass: 0.0,
-        mu: 0.0,
-        mobile: 0.0,
-    }; MAX_PHASES];
-    let mut tait_b = [1.0f32; 4];
-    let mut dt_visc = f64::from(f32::MAX);
-    for (k, p) in derived.phases.iter().enumerate() {
-        phases[k] = PhaseParams {
-            rho0: p.rho0 as f32,
-            mass: p.mass as f32,
-            mu: p.viscosity_pa_s as f32,
-            mobile: if p.mobile { 1.0 } else { 0.0 },
-        };
-        tait_b[k] = derived::tait_b(derived.c0, p.rho0) as f32;
-        if p.mobile
-            && p.viscosity_pa_s > 0.0
-            && matches!(case.numerics.viscosity, Viscosity::Laminar)
-        {
-            dt_visc = dt_visc.min(0.125 * h * h * p.rho0 / p.viscosity_pa_s);
-        }
-    }
-    let (viscosity_mode, alpha) = match case.numerics.viscosity {
-        Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha),
-        Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0),
-        Viscosity::Multiphase {
-            alpha,
-            eddy_m2_per_s,
-            ..
-        } => (
-            VISCOSITY_MULTIPHASE,
-            alpha + derived::monaghan_alpha(eddy_m2_per_s, h, derived.c0, case.dim()),
-        ),
-    };
-    let sps_length2 = match case.numerics.viscosity {
-        Viscosity::Multiphase { smagorinsky_cs, .. } => {
-            (smagorinsky_cs * case.numerics.dp_m).powi(2) as f32
-        }
-        _ => 0.0,
-    };
+    let (phases, tait_b, dt_visc) = phase_blocks(case, derived);
+    let (viscosity_mode, alpha, sps_length2) = viscosity_block(case, derived);
     let (diffusion_mode, delta) = match case.numerics.density_diffusion {
         DensityDiffusion::None => (DIFFUSION_NONE, 0.0),
         DensityDiffusion::MolteniColagrossi2009 { delta } => (DIFFUSION_MOLTENI, delta),
@@ -123,6 +84,55 @@ pub fn sim_params(
         tait_b,
         sediment: sediment_params(case, derived),
         flume: flume_params(case, derived),
+    }
+}
+
+/// Each phase's block, its Tait coefficient, and the viscous step bound of a laminar
+/// viscosity (s; f32::MAX where none binds).
+fn phase_blocks(case: &Case, derived: &Derived) -> ([PhaseParams; MAX_PHASES], [f32; 4], f64) {
+    let h = derived.h;
+    let mut phases = [PhaseParams {
+        rho0: 1000.0,
+        mass: 0.0,
+        mu: 0.0,
+        mobile: 0.0,
+    }; MAX_PHASES];
+    let mut tait_b = [1.0f32; 4];
+    let mut dt_visc = f64::from(f32::MAX);
+    for (k, p) in derived.phases.iter().enumerate() {
+        phases[k] = PhaseParams {
+            rho0: p.rho0 as f32,
+            mass: p.mass as f32,
+            mu: p.viscosity_pa_s as f32,
+            mobile: if p.mobile { 1.0 } else { 0.0 },
+        };
+        tait_b[k] = derived::tait_b(derived.c0, p.rho0) as f32;
+        if p.mobile
+            && p.viscosity_pa_s > 0.0
+            && matches!(case.numerics.viscosity, Viscosity::Laminar)
+        {
+            dt_visc = dt_visc.min(0.125 * h * h * p.rho0 / p.viscosity_pa_s);
+        }
+    }
+    (phases, tait_b, dt_visc)
+}
+
+/// The viscosity's mode, its artificial alpha (an eddy viscosity given as one), and the
+/// Smagorinsky length squared (m2; 0 without).
+fn viscosity_block(case: &Case, derived: &Derived) -> (u32, f64, f32) {
+    let (h, c0) = (derived.h, derived.c0);
+    match case.numerics.viscosity {
+        Viscosity::Artificial { alpha } => (VISCOSITY_ARTIFICIAL, alpha, 0.0),
+        Viscosity::Laminar => (VISCOSITY_LAMINAR, 0.0, 0.0),
+        Viscosity::Multiphase {
+            alpha,
+            eddy_m2_per_s,
+            smagorinsky_cs,
+        } => (
+            VISCOSITY_MULTIPHASE,
+            alpha + derived::monaghan_alpha(eddy_m2_per_s, h, c0, case.dim()),
+            (smagorinsky_cs * case.numerics.dp_m).powi(2) as f32,
+        ),
     }
 }
 

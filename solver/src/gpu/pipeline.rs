@@ -9,9 +9,9 @@
 //! particles only; `parked_copy` carries the parked ones over into the next state.
 
 use crate::gpu::GpuContext;
-use crate::gpu::stage::{Stage, groups};
+use crate::gpu::stage::{AsBinding, Stage, groups};
 use crate::gpu::stages::{self, PREFIX_SUM_BLOCK};
-use crate::gpu::state::GpuBuffers;
+use crate::gpu::state::{GpuBuffers, StateTextures};
 
 /// Workgroup sizes `active_dispatch` counts the active particles in: the neighbour passes'
 /// and the per-particle passes' (the integrators, `parked_copy`, `observe_reduce`).
@@ -192,6 +192,9 @@ impl SphPipeline {
             scan.push((self.prefix_sum.bind(d, &[info, data, sums]), *len));
             data = sums;
         }
+        let [grid_scatter, parked_copy, reorder] = self.bind_sort_copies(d, g);
+        let [symplectic_predictor, symplectic_corrector, verlet_update] = self.bind_updates(d, g);
+        let (predict, correct) = (pass_buffers(g, &g.b), pass_buffers(g, &g.c));
         Bindings {
             grid_clear: self
                 .grid_clear
@@ -200,186 +203,25 @@ impl SphPipeline {
                 .grid_count
                 .bind(d, &[&g.params, &g.a.positions, &g.cell_of, &g.cell_starts]),
             scan,
-            grid_scatter: self.grid_scatter.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.cell_of,
-                    &g.cell_starts,
-                    &g.cell_cursor,
-                    &g.sorted_index,
-                ],
-            ),
+            grid_scatter,
             cell_sort: self
                 .cell_sort
                 .bind(d, &[&g.params, &g.cell_starts, &g.a.ids, &g.sorted_index]),
             active_dispatch: self
                 .active_dispatch
                 .bind(d, &[&g.params, &g.cell_starts, &g.dispatch]),
-            parked_copy: self.parked_copy.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.state,
-                    &g.cell_starts,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.b_ids,
-                    &g.a.positions,
-                    &g.a.vel_rho,
-                    &g.a.ids,
-                    &g.a.vel_rho_prev,
-                    &g.regions,
-                ],
-            ),
-            reorder: self.reorder.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.sorted_index,
-                    &g.a.positions,
-                    &g.a.vel_rho,
-                    &g.a.ids,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.b_ids,
-                    &g.a.vel_rho_prev,
-                    &g.b_vel_rho_prev,
-                ],
-            ),
-            forces_predict: self.forces_predict.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.cell_starts,
-                    &g.forces,
-                    &g.state,
-                    &g.stress_a,
-                    &g.stress_b,
-                ],
-            ),
-            forces_correct: self.forces_correct.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.c.positions,
-                    &g.c.vel_rho,
-                    &g.cell_starts,
-                    &g.forces,
-                    &g.state,
-                    &g.stress_a,
-                    &g.stress_b,
-                ],
-            ),
-            rheology_predict: self.rheology_predict.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.cell_starts,
-                    &g.state,
-                    &g.stress_a,
-                    &g.stress_b,
-                    &g.regions,
-                    &g.b_ids,
-                ],
-            ),
-            release_predict: self.release_predict.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.cell_starts,
-                    &g.state,
-                    &g.stress_a,
-                    &g.stress_b,
-                    &g.regions,
-                    &g.b_ids,
-                ],
-            ),
-            rheology_correct: self.rheology_correct.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.c.positions,
-                    &g.c.vel_rho,
-                    &g.cell_starts,
-                    &g.state,
-                    &g.stress_a,
-                    &g.stress_b,
-                    &g.regions,
-                    &g.b_ids,
-                ],
-            ),
-            release_correct: self.release_correct.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.c.positions,
-                    &g.c.vel_rho,
-                    &g.cell_starts,
-                    &g.state,
-                    &g.stress_a,
-                    &g.stress_b,
-                    &g.regions,
-                    &g.b_ids,
-                ],
-            ),
+            parked_copy,
+            reorder,
+            forces_predict: self.forces_predict.bind(d, &predict),
+            forces_correct: self.forces_correct.bind(d, &correct),
+            rheology_predict: self.rheology_predict.bind(d, &rheology_buffers(g, &g.b)),
+            release_predict: self.release_predict.bind(d, &rheology_buffers(g, &g.b)),
+            rheology_correct: self.rheology_correct.bind(d, &rheology_buffers(g, &g.c)),
+            release_correct: self.release_correct.bind(d, &rheology_buffers(g, &g.c)),
             dt_update: self.dt_update.bind(d, &[&g.params, &g.state]),
-            symplectic_predictor: self.symplectic_predictor.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.state,
-                    &g.forces,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.c.positions,
-                    &g.c.vel_rho,
-                    &g.regions,
-                    &g.b_ids,
-                    &g.cell_starts,
-                ],
-            ),
-            symplectic_corrector: self.symplectic_corrector.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.state,
-                    &g.forces,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.b_ids,
-                    &g.c.vel_rho,
-                    &g.a.positions,
-                    &g.a.vel_rho,
-                    &g.a.ids,
-                    &g.regions,
-                    &g.cell_starts,
-                ],
-            ),
-            verlet_update: self.verlet_update.bind(
-                d,
-                &[
-                    &g.params,
-                    &g.state,
-                    &g.forces,
-                    &g.b.positions,
-                    &g.b.vel_rho,
-                    &g.b_ids,
-                    &g.b_vel_rho_prev,
-                    &g.a.positions,
-                    &g.a.vel_rho,
-                    &g.a.ids,
-                    &g.a.vel_rho_prev,
-                    &g.regions,
-                    &g.cell_starts,
-                ],
-            ),
+            symplectic_predictor,
+            symplectic_corrector,
+            verlet_update,
             probe_interpolate: self.probe_interpolate.bind(
                 d,
                 &[
@@ -408,6 +250,110 @@ impl SphPipeline {
             n_cells,
             n_probes,
         }
+    }
+
+    /// The sort's copies between the states: the scatter into cells, the parked particles'
+    /// copy and the reorder of `a` into `b`.
+    fn bind_sort_copies(&self, d: &wgpu::Device, g: &GpuBuffers) -> [wgpu::BindGroup; 3] {
+        [
+            self.grid_scatter.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.cell_of,
+                    &g.cell_starts,
+                    &g.cell_cursor,
+                    &g.sorted_index,
+                ],
+            ),
+            self.parked_copy.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.cell_starts,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.a.vel_rho_prev,
+                    &g.regions,
+                ],
+            ),
+            self.reorder.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.sorted_index,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.a.vel_rho_prev,
+                    &g.b_vel_rho_prev,
+                ],
+            ),
+        ]
+    }
+
+    /// The integrators' updates: the symplectic predictor and corrector, and Verlet's step.
+    fn bind_updates(&self, d: &wgpu::Device, g: &GpuBuffers) -> [wgpu::BindGroup; 3] {
+        [
+            self.symplectic_predictor.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.forces,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.c.positions,
+                    &g.c.vel_rho,
+                    &g.regions,
+                    &g.b_ids,
+                    &g.cell_starts,
+                ],
+            ),
+            self.symplectic_corrector.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.forces,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.c.vel_rho,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.regions,
+                    &g.cell_starts,
+                ],
+            ),
+            self.verlet_update.bind(
+                d,
+                &[
+                    &g.params,
+                    &g.state,
+                    &g.forces,
+                    &g.b.positions,
+                    &g.b.vel_rho,
+                    &g.b_ids,
+                    &g.b_vel_rho_prev,
+                    &g.a.positions,
+                    &g.a.vel_rho,
+                    &g.a.ids,
+                    &g.a.vel_rho_prev,
+                    &g.regions,
+                    &g.cell_starts,
+                ],
+            ),
+        ]
     }
 
     /// Neighbour search: counting sort of state `a` into cells (an open flume's parked
@@ -513,4 +459,35 @@ impl SphPipeline {
             .record_items(pass, 0, &b.probe_interpolate, b.n_probes);
         self.record_active(pass, b, &self.observe_reduce, &b.observe_reduce);
     }
+}
+
+/// The force pass's buffers over the neighbours of state `s`: the parameters, `s`, the cells,
+/// the forces, the step's state and the stress textures.
+fn pass_buffers<'a>(g: &'a GpuBuffers, s: &'a StateTextures) -> [&'a dyn AsBinding; 8] {
+    [
+        &g.params,
+        &s.positions,
+        &s.vel_rho,
+        &g.cell_starts,
+        &g.forces,
+        &g.state,
+        &g.stress_a,
+        &g.stress_b,
+    ]
+}
+
+/// The rheology's and the release's buffers over the neighbours of state `s`, whose ids are
+/// `b_ids` (the passes read the sorted states only).
+fn rheology_buffers<'a>(g: &'a GpuBuffers, s: &'a StateTextures) -> [&'a dyn AsBinding; 9] {
+    [
+        &g.params,
+        &s.positions,
+        &s.vel_rho,
+        &g.cell_starts,
+        &g.state,
+        &g.stress_a,
+        &g.stress_b,
+        &g.regions,
+        &g.b_ids,
+    ]
 }

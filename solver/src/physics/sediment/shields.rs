@@ -191,15 +191,7 @@ pub struct FrictionVelocity {
 /// sub-layer, `11.6 nu / z`, the largest u* the profile can account for. Non-physical input (NaN,
 /// u < 0, z <= 0, nu <= 0, ks < 0) gives `u_star = 0`, `converged = false`. u = 0 gives u* = 0.
 pub fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> FrictionVelocity {
-    let physical = u.is_finite()
-        && u >= 0.0
-        && z.is_finite()
-        && z > 0.0
-        && nu.is_finite()
-        && nu > 0.0
-        && ks.is_finite()
-        && ks >= 0.0;
-    if !physical {
+    if !physical(u, z, ks, nu) {
         return FrictionVelocity {
             u_star: 0.0,
             iterations: 0,
@@ -222,27 +214,8 @@ pub fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> FrictionVelocity {
         return done(guess, 0);
     }
 
-    // 2. Log law above the sub-layer, on the u* ranges of the three z0 regimes. With ks = 0 the
-    // bed is smooth at every u*: the transitional and rough ranges start at infinity.
-    let (smooth_top, rough_bottom) = if ks > 0.0 {
-        (SMOOTH_RE_K * nu / ks, ROUGH_RE_K * nu / ks)
-    } else {
-        (f32::INFINITY, f32::INFINITY)
-    };
-    let ranges = [
-        (Roughness::Smooth, sublayer_top, smooth_top),
-        (
-            Roughness::Transitional,
-            sublayer_top.max(smooth_top),
-            rough_bottom,
-        ),
-        (
-            Roughness::Rough,
-            sublayer_top.max(rough_bottom),
-            f32::INFINITY,
-        ),
-    ];
-    for (regime, lo, hi) in ranges {
+    // 2. Log law above the sub-layer, on the u* ranges of the three z0 regimes.
+    for (regime, lo, hi) in log_ranges(sublayer_top, ks, nu) {
         if lo >= hi {
             continue;
         }
@@ -281,6 +254,42 @@ pub fn friction_velocity(u: f32, z: f32, ks: f32, nu: f32) -> FrictionVelocity {
         iterations: 0,
         converged: false,
     }
+}
+
+/// Whether the inputs of [`friction_velocity`] describe a flow: finite, u and ks not
+/// negative, z and nu positive.
+fn physical(u: f32, z: f32, ks: f32, nu: f32) -> bool {
+    u.is_finite()
+        && u >= 0.0
+        && z.is_finite()
+        && z > 0.0
+        && nu.is_finite()
+        && nu > 0.0
+        && ks.is_finite()
+        && ks >= 0.0
+}
+
+/// The u* ranges (m/s) of the three z0 regimes above the sub-layer's top `sublayer_top`. With
+/// ks = 0 the bed is smooth at every u*: the transitional and rough ranges start at infinity.
+fn log_ranges(sublayer_top: f32, ks: f32, nu: f32) -> [(Roughness, f32, f32); 3] {
+    let (smooth_top, rough_bottom) = if ks > 0.0 {
+        (SMOOTH_RE_K * nu / ks, ROUGH_RE_K * nu / ks)
+    } else {
+        (f32::INFINITY, f32::INFINITY)
+    };
+    [
+        (Roughness::Smooth, sublayer_top, smooth_top),
+        (
+            Roughness::Transitional,
+            sublayer_top.max(smooth_top),
+            rough_bottom,
+        ),
+        (
+            Roughness::Rough,
+            sublayer_top.max(rough_bottom),
+            f32::INFINITY,
+        ),
+    ]
 }
 
 /// `d u / d u*` of the log law of `regime` at height `z` (the smooth and transitional ranges):
