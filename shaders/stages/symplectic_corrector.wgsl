@@ -41,5 +41,5 @@ fn symplectic_corrector(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     ids_out[i] = ids_n[i];
     let v = vr.xyz + dt * f.xyz;
-    store_state(i, ids_n[i], p, vr, p.xyz + dt * 0.5 * (vr.xyz + v), v, rho, ph);
+    store_state(i, ids_n[i], p, vr, p.xyz + dt * 0.5 * (vr.xyz + v), v, rho);
 }

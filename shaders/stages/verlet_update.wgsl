@@ -56,5 +56,5 @@ fn verlet_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     let held = ph.mobile > 0.5 && is_held(ids_n[i]);
     vel_rho_prev_out[i] = select(vr, vec4<f32>(0.0, 0.0, 0.0, vr.w), held);
     let x = p.xyz + dt * vr.xyz + (0.5 * dt * dt) * f.xyz;
-    store_state(i, ids_n[i], p, vr, x, base.xyz + span * f.xyz, rho, ph);
+    store_state(i, ids_n[i], p, vr, x, base.xyz + span * f.xyz, rho);
 }

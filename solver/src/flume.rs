@@ -1,6 +1,6 @@
 //! The host's half of the open flume: the discharge, the inlet buffer's new columns, and the
 //! count of parked particles and of eroded sediment. The GPU half (the inlet's imposed
-//! velocity, parking at the outlet and the collector) is in `shaders/common/store_state.wgsl`.
+//! velocity, parking at the outlet and the collector) is in `shaders/common/store_rule.wgsl`.
 //!
 //! The particle count never changes. A particle that leaves (over the weir, or as sediment
 //! into the collector) is parked: it becomes water at its own spot above the flume, where it

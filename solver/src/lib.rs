@@ -65,3 +65,6 @@ pub mod gpu;
 pub mod particles;
 #[doc(hidden)]
 pub mod simulation;
+/// The CPU backend's end of a step, which `tests/wgsl_store.rs` holds `store_rule.wgsl` to.
+#[doc(hidden)]
+pub use cpu::store::{Event as StoreEvent, Store};

@@ -61,7 +61,7 @@ pub fn sim_params(
         dt_visc: dt_visc as f32,
         // A step a million times below the acoustic one means the state has gone bad.
         dt_min: (1e-6 * h / derived.c0) as f32,
-        // An open flume excludes a free particle beyond this (store_state.wgsl); in a closed
+        // An open flume excludes a free particle beyond this (store_rule.wgsl); in a closed
         // tank it is a runaway.
         rho_ratio_max: if case.open_flume.is_some() {
             RHO_RATIO_EXCLUDE

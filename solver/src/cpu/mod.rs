@@ -16,7 +16,7 @@ mod multiphase;
 mod observe;
 mod simd;
 mod step;
-mod store;
+pub(crate) mod store;
 
 use crate::contract::{Extremes, SimParams, StepState, VISCOSITY_MULTIPHASE};
 use crate::engine::{Engine, InletScan, RawState, StageTime};

@@ -1,4 +1,5 @@
-//! The end of a step on the CPU backend (`store_state.wgsl`, and the open flume's branches of
+//! The end of a step on the CPU backend (`store_rule.wgsl`, held to it input by input by
+//! `tests/wgsl_store.rs`, and the open flume's branches of
 //! the symplectic predictor): walls, held sediment, free particles with their health check,
 //! and in an open flume the outlet, the collector, the inlet buffer, a bottom outlet's duct,
 //! the parked reservoir and the exclusion of a particle whose density left the range.
@@ -76,8 +77,8 @@ impl<'a> Store<'a> {
     /// An inlet buffer particle's density: the one it entered with, or under the generalised
     /// wall condition its own by continuity (`integrated`, no tension): at rest density the
     /// buffer pushes on the water it meets with no pressure, and the water it squeezes out ran
-    /// into the apron under it and through it (`physics::boundary`). Mirrors `inlet_density`
-    /// in params.wgsl.
+    /// into the apron under it and through it (`physics::boundary`). `inlet_density` of
+    /// params.wgsl, compared by `tests/wgsl_store.rs`.
     fn inlet_density(&self, phase: &Phase, entered: f32, integrated: f32) -> f32 {
         if self.params.boundary_mode == BOUNDARY_GENERALISED {
             integrated.max(phase.rho0)
@@ -233,7 +234,7 @@ impl<'a> Store<'a> {
             + v[1] * v[1]
             + v[2] * v[2]
             + v[3];
-        // Infinities (and sums near them) exceed the bound of store_state.wgsl; NaN fails it.
+        // Infinities (and sums near them) exceed the bound of store_rule.wgsl; NaN fails it.
         let flags = if s.is_nan() || s.abs() > 3.0e38 {
             Health::NON_FINITE
         } else if (v[3] / phase.rho0 - 1.0).abs() > self.params.rho_ratio_max {

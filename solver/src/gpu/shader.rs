@@ -19,6 +19,7 @@ pub const SOURCES: &[(&str, &str)] = embed![
     "common/neighbours.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
+    "common/store_rule.wgsl",
     "common/store_state.wgsl",
     "common/sediment.wgsl",
     "common/chunk_idle.wgsl",

@@ -43,6 +43,7 @@ const FULL_STEP: &[&str] = &[
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
     "common/flume.wgsl",
+    "common/store_rule.wgsl",
     "common/store_state.wgsl",
 ];
 

@@ -231,7 +231,7 @@ pub fn verlet(
 /// `vel_rho` at n: a held mobile particle keeps its position at rest in both of the leapfrog's
 /// sequences (its `vel_rho_prev` at n is at rest too, so that released at n + 1 it does not
 /// take back the velocity of n - 1), and with `clamp` (no tension) its density stays at or
-/// above rho0, as `store_state.wgsl` does.
+/// above rho0, as `store_rule.wgsl` does.
 ///
 /// Panics if the slices differ in length (caller bugs).
 pub fn hold_at_rest(

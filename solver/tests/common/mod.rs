@@ -4,6 +4,7 @@
 
 pub mod held_bed;
 pub mod parked;
+pub mod probe;
 pub mod stages;
 
 use flume_solver::{Backend, GpuContext};

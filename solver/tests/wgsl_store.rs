@@ -1,0 +1,193 @@
+//! The end of a step, `store_rule` of `shaders/common/store_rule.wgsl`, against the CPU
+//! backend's `Store::apply`, input by input on the adapter (lavapipe in CI): what each
+//! particle becomes (kept, parked over the weir, parked as eroded sand, excluded for its
+//! density), its new position and velocity-density, and the health flags it raises, for
+//! water, sand and walls at every place the open flume treats apart (the bed, past the weir,
+//! the collector, the inlet buffer, a bottom outlet's duct), held or not, at densities at
+//! rest, under it, past the exclusion bound and infinite.
+//!
+//! The two sides share no code: a store rule changed on one side only fails here. Where their
+//! contracts differ the inputs keep to both: the CPU backend's integrator gives a wall its
+//! position, velocity and floor on density before the store (`integrate.rs`), the WGSL's store
+//! does it, so walls are given at rest with a density at or above rest.
+
+mod common;
+
+use common::gpu_lock;
+use common::probe::{Input, Probe, probe_of, same};
+use flume_solver::gpu::shader;
+use flume_solver::{Case, Store};
+
+/// The step of every probe, s.
+const DT: f32 = 0.01;
+
+/// The WGSL side: `a` = (x, y, new density, phase bits), `b` = (u, v, old density, held +
+/// 2 id); the old velocity is half the new, the free new position x + DT v.
+const STORE_PROBE: &str = "
+const DT: f32 = 0.01;
+fn store_probe(a: vec4<f32>, b: vec4<f32>) -> Stored {
+    let p = vec4<f32>(a.x, a.y, 0.0, a.w);
+    let code = u32(b.w);
+    let v = vec3<f32>(b.x, b.y, 0.0);
+    let vr = vec4<f32>(0.5 * v, b.z);
+    return store_rule(code / 2u, p, vr, p.xyz + DT * v, v, a.z, (code & 1u) != 0u, DT);
+}
+";
+
+/// The fates of `store_rule.wgsl`.
+const KEPT: f32 = 0.0;
+const PARKED: f32 = 1.0;
+const ERODED: f32 = 2.0;
+const EXCLUDED: f32 = 3.0;
+
+/// The Rust side of one input: position, velocity-density, and (fate, flags, 0, 0).
+fn rust_store(store: &Store, input: &Input) -> [[f32; 4]; 3] {
+    let [a, b] = *input;
+    let code = b[3] as u32;
+    let (id, held) = (code / 2, code & 1 != 0);
+    let p = [a[0], a[1], 0.0, a[3]];
+    let v = [b[0], b[1], 0.0];
+    let vr = [0.5 * v[0], 0.5 * v[1], 0.0, b[2]];
+    let x = [p[0] + DT * v[0], p[1] + DT * v[1], p[2] + DT * v[2], p[3]];
+    let ((pos, vel_rho), event) = store.apply(id, &p, &vr, held, DT, (x, [v[0], v[1], 0.0, a[2]]));
+    let fate = match (event.excluded.is_some(), event.parked, event.eroded) {
+        (true, _, _) => EXCLUDED,
+        (false, true, true) => ERODED,
+        (false, true, false) => PARKED,
+        _ => KEPT,
+    };
+    [pos, vel_rho, [fate, event.flags as f32, 0.0, 0.0]]
+}
+
+/// The places of the flume that the store treats apart: on the bed, past the weir, in the
+/// collector, in the inlet buffer, and in the duct when there is one, each well clear of its
+/// edges.
+fn places(probe: &Probe) -> Vec<[f32; 2]> {
+    let f = &probe.uniform.flume;
+    let mut at = vec![
+        [1.0, 0.08],
+        [f.outlet_x + 0.05, 0.06],
+        [
+            0.5 * (f.collector_x_min + f.collector_x_max),
+            0.5 * f.collector_y_max,
+        ],
+        [
+            f.inlet_x_face - 0.004,
+            0.5 * (f.inlet_y_min + f.inlet_y_max),
+        ],
+    ];
+    if f.duct_y_max > f.duct_y_min {
+        at.push([f.duct_x_min + 0.05, 0.5 * (f.duct_y_min + f.duct_y_max)]);
+    }
+    at
+}
+
+/// Water, sand and walls at every place, moving or at rest, held or not, at densities at
+/// rest, 4 % under it, 20 % over it (past the exclusion bound) and infinite.
+fn inputs(probe: &Probe) -> Vec<Input> {
+    let (f, sediment) = (&probe.uniform.flume, probe.uniform.sediment.phase);
+    let wall = (0..probe.params.phases.len() as u32)
+        .find(|&k| !probe.params.phases[k as usize].mobile && k != f.parked_phase)
+        .expect("a wall phase");
+    let mut out = Vec::new();
+    for [x, y] in places(probe) {
+        for phase in [f.water_phase, sediment, wall] {
+            let rho0 = probe.params.phases[phase as usize].rho0;
+            let mobile = phase != wall;
+            let speeds: &[[f32; 2]] = if mobile {
+                &[[0.3, -0.1], [0.0, 0.0]]
+            } else {
+                &[[0.0, 0.0]]
+            };
+            let rhos: &[f32] = if mobile {
+                &[rho0, 0.96 * rho0, 1.2 * rho0, f32::INFINITY]
+            } else {
+                &[rho0, 1.02 * rho0]
+            };
+            for &[u, v] in speeds {
+                for &rho in rhos {
+                    for held in [0.0, 1.0] {
+                        let a = [x, y, rho, f32::from_bits(phase)];
+                        out.push([a, [u, v, 1.01 * rho0, held + 2.0 * 123.0]]);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Runs the probe over the case's inputs and asserts every output against the CPU's, and that
+/// the inputs reach every fate in `fates`.
+fn agree_on(probe: &Probe, fates: &[f32]) {
+    let helpers = [
+        shader::source("common/flume.wgsl"),
+        shader::source("common/store_rule.wgsl"),
+        STORE_PROBE,
+    ]
+    .concat();
+    let inputs = inputs(probe);
+    let gpu = [
+        probe.run_with(&helpers, "store_probe(a, b).pos", &inputs),
+        probe.run_with(&helpers, "store_probe(a, b).vel_rho", &inputs),
+        probe.run_with(
+            &helpers,
+            "vec4<f32>(f32(store_probe(a, b).fate), f32(store_probe(a, b).flags), 0.0, 0.0)",
+            &inputs,
+        ),
+    ];
+    let store = Store::new(&probe.uniform, &probe.params);
+    let mut reached = Vec::new();
+    for (k, input) in inputs.iter().enumerate() {
+        let want = rust_store(&store, input);
+        for (what, (got, want)) in ["position", "velocity-density", "fate and flags"]
+            .iter()
+            .zip(gpu.iter().map(|g| g[k]).zip(want))
+        {
+            assert!(
+                got.iter().zip(&want).all(|(g, w)| same(*g, *w, 0.0)),
+                "{what} at {input:?}: WGSL {got:?} against Rust {want:?}"
+            );
+        }
+        reached.push(want[2][0]);
+    }
+    for fate in fates {
+        assert!(reached.contains(fate), "no input reaches fate {fate}");
+    }
+}
+
+fn case(path: &str, dp_m: f64) -> Case {
+    let mut case = Case::from_path(&common::case_path(path)).expect("case parses");
+    case.numerics.dp_m = dp_m;
+    case
+}
+
+#[test]
+fn the_store_rule_on_the_ulbra_flume() {
+    let _lock = gpu_lock();
+    let mut flume = case("../launch_configs/ulbra_flume.yaml", 0.01);
+    if let Some(f) = &mut flume.open_flume {
+        f.reservoir_particles = 2500;
+    }
+    let Some(probe) = probe_of(&flume) else {
+        return;
+    };
+    agree_on(&probe, &[KEPT, PARKED, ERODED, EXCLUDED]);
+    // The inlet buffer's density under the generalised wall condition is its own.
+    flume.numerics.boundary = flume_solver::config::BoundaryMethod::Generalised;
+    let probe = probe_of(&flume).expect("the adapter opened once");
+    agree_on(&probe, &[KEPT, PARKED, ERODED, EXCLUDED]);
+}
+
+#[test]
+fn the_store_rule_at_a_bottom_outlet() {
+    let _lock = gpu_lock();
+    let Some(probe) = probe_of(&case("../launch_configs/falappi_flushing.yaml", 0.02)) else {
+        return;
+    };
+    assert!(
+        probe.uniform.flume.duct_y_max > probe.uniform.flume.duct_y_min,
+        "the case has a duct"
+    );
+    agree_on(&probe, &[KEPT, PARKED, EXCLUDED]);
+}
