@@ -31,10 +31,9 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = forces[i];
     let phase = bitcast<u32>(p.w);
     let rho = vr.w + half_dt * f.w;
-    let fl = params.flume;
-    if (fl.enabled != 0u && phase == fl.water_phase && p.x < fl.inlet_x_face && p.y > fl.inlet_y_min && p.y <= fl.inlet_y_max) {
-        // The inlet buffer moves at the inlet velocity, at its density (store_state.wgsl).
-        let u = vec3<f32>(fl.inlet_u, 0.0, 0.0);
+    if (phase == params.flume.water_phase && in_inlet(p.xyz)) {
+        // The inlet buffer moves at the inlet velocity, at its density (store_rule.wgsl).
+        let u = vec3<f32>(params.flume.inlet_u, 0.0, 0.0);
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * u, p.w));
         textureStore(vel_rho_half, texel(i), vec4<f32>(u, inlet_density(vr.w, rho, phase)));
     } else if (params.phases[phase].mobile > 0.5 && (regions[ids_n[i]] & REGION_HELD_BIT) != 0u) {

@@ -37,6 +37,7 @@ const HALF_STEP: &[&str] = &[
     "common/params.wgsl",
     "common/particle_texture.wgsl",
     "common/step_state.wgsl",
+    "common/flume.wgsl",
 ];
 const FULL_STEP: &[&str] = &[
     "common/params.wgsl",
