@@ -258,7 +258,7 @@ fn picked_up(id: u32, step: u32, rate: f32, dt: f32) -> bool {
 // A sediment particle's region (Figure 2 with the hold; `sediment_region` in pass.rs): in the
 // Shields-only mode suspended below the concentration, else bed load or held; in the
 // Drucker-Prager mode a particle held before stays un-yielded unless Shields makes it bed load
-// (only yield_release frees it otherwise), any other is bed load, yielded or not, and then
+// (only the hold stage frees it otherwise), any other is bed load, yielded or not, and then
 // suspended below the concentration unless un-yielded. A particle held before that has not been
 // picked up stays held.
 fn sediment_region(r: RegionInputs) -> u32 {

@@ -4,7 +4,7 @@
 // particle (Eqs. 16-25), the concentration (Eq. 32), the region of Figure 2 and its apparent
 // viscosity (Eqs. 15, 33); then the viscous stress tau = 2 mu eps that the force pass
 // differentiates. Un-yielded sediment is held (REGION_HELD); in the Drucker-Prager mode a held
-// particle stays held here unless Shields makes it bed load, and the yield_release stage that
+// particle stays held here unless Shields makes it bed load, and the hold stage that
 // follows releases it. Reference: solver/src/physics/sediment/pass.rs.
 
 @group(0) @binding(1) var positions: texture_2d<f32>;
@@ -183,7 +183,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     let t = select(2.0 * mu, 0.0, held && sd.shields_only != 0u) * eps;
     let word = region | select(0u, REGION_HELD, held);
     textureStore(stress_a, texel(i), vec4<f32>(t[0].x, t[1].x, t[2].x, t[1].y));
-    // The whole region word: yield_release reads which neighbours this pass held.
+    // The whole region word: the hold stage reads which neighbours this pass held.
     textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(word)));
     // By particle id: the integrators, the probes and the host each see the particles in a
     // different order.

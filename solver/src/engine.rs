@@ -109,7 +109,8 @@ pub struct PipelineShape {
     pub divisions: u32,
     pub verlet: bool,
     pub multiphase: bool,
-    pub yield_release: bool,
+    /// The hold stage, which releases held sediment that yields (Drucker-Prager).
+    pub hold: bool,
 }
 
 /// Particles listed in storage order, reordered by id (index i holds the particle of id i).

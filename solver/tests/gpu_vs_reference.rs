@@ -19,22 +19,22 @@ fn grid_stages_match_a_cpu_counting_sort_exactly() {
 }
 
 #[test]
-fn forces_wcsph_matches_the_cpu_interaction_2d() {
+fn the_interaction_stage_matches_the_cpu_2d() {
     on_gpu(|b| stages::check_forces(b, case("tests/cases/hydrostatic_2d.yaml"), "2-D", 7));
 }
 
 #[test]
-fn forces_wcsph_matches_the_cpu_interaction_3d() {
+fn the_interaction_stage_matches_the_cpu_3d() {
     on_gpu(|b| stages::check_forces(b, case("tests/cases/hydrostatic_3d.yaml"), "3-D", 8));
 }
 
 #[test]
-fn forces_wcsph_molteni_diffusion_matches_the_cpu_interaction() {
+fn the_interaction_stage_with_molteni_diffusion_matches_the_cpu() {
     on_gpu(|b| stages::check_forces(b, stages::molteni_case(), "Molteni-Colagrossi", 19));
 }
 
 #[test]
-fn forces_wcsph_generalised_walls_match_the_cpu_interaction() {
+fn the_interaction_stage_with_generalised_walls_matches_the_cpu() {
     on_gpu(stages::check_generalised_wall_forces);
 }
 
@@ -47,7 +47,7 @@ fn steps_under_generalised_walls_match_the_cpu_steps() {
 }
 
 #[test]
-fn forces_wcsph_laminar_matches_the_cpu_interaction() {
+fn the_interaction_stage_with_laminar_viscosity_matches_the_cpu() {
     on_gpu(stages::check_laminar_forces);
 }
 

@@ -137,17 +137,17 @@ fn every_constant_stated_on_both_sides_agrees() {
     let region = |r: Region| U32(r as u32);
     let checks = [
         (
-            "forces_wcsph",
+            "interaction",
             "TEXEL_ROW_SHIFT",
             U32(flume_solver::gpu::state::TEXEL_ROW_SHIFT),
         ),
         (
-            "forces_wcsph",
+            "interaction",
             "VISCOSITY_MULTIPHASE",
             U32(c::VISCOSITY_MULTIPHASE),
         ),
         (
-            "forces_wcsph",
+            "interaction",
             "BOUNDARY_GENERALISED",
             U32(c::BOUNDARY_GENERALISED),
         ),
@@ -168,9 +168,9 @@ fn every_constant_stated_on_both_sides_agrees() {
             U32(Health::DENSITY_RUNAWAY),
         ),
         ("dt_update", "STATUS_DT_COLLAPSE", U32(Health::DT_COLLAPSE)),
-        ("yield_release", "FLOW_ONSET", F32(hold::FLOW_ONSET)),
+        ("hold", "FLOW_ONSET", F32(hold::FLOW_ONSET)),
         (
-            "forces_wcsph",
+            "interaction",
             "CONTACT_REACH",
             F32(flume_solver::physics::interaction::CONTACT_REACH),
         ),
@@ -259,9 +259,9 @@ fn find(members: &[(String, u32)], name: &str) -> u32 {
 fn rust_mirrors_have_the_wgsl_layout() {
     let forces = ALL
         .iter()
-        .find(|s| s.name == "forces_wcsph")
+        .find(|s| s.name == "interaction")
         .expect("forces stage");
-    let module = parse("forces_wcsph", &forces.source());
+    let module = parse("interaction", &forces.source());
     let (m, size) = wgsl_layout(&module, "SimParams");
     assert_eq!(size as usize, size_of::<SimParams>());
     macro_rules! same {

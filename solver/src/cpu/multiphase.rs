@@ -1,5 +1,5 @@
 //! The water-sediment model's neighbour passes on the CPU backend (`rheology.wgsl`,
-//! `yield_release.wgsl`): `physics::sediment`'s per-pair and per-particle functions over the
+//! `hold.wgsl`): `physics::sediment`'s per-pair and per-particle functions over the
 //! cell list, particles shared out among threads in blocks and the rheology's pairs taken in
 //! lanes, a group of one row of cells at once, as the force pass takes them. A release reads
 //! the regions the rheology pass left, before any release, so it does not depend on the order

@@ -134,7 +134,7 @@ impl CpuEngine {
             draws,
             awake_set: self.awake_set,
         };
-        let release = self.shape.yield_release;
+        let release = self.shape.hold;
         let (params, pool) = (&self.model, &self.pool);
         let pass = rheology_pass(pool, params, model, grid, pos, vel, &holds, release);
         self.count(STAGE_RHEOLOGY, active, pass.asleep);

@@ -54,7 +54,7 @@ impl GpuEngine {
             shape.divisions,
             shape.verlet,
             shape.multiphase,
-            shape.yield_release,
+            shape.hold,
         );
         let n = particles.len() as u32;
         let bindings = pipeline.bind(&gpu, &buffers, n, params.n_cells, params.n_probes);

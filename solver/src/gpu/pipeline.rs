@@ -58,7 +58,7 @@ pub struct SphPipeline {
     /// Viscous stress from the rheology pass before each force pass.
     multiphase: bool,
     /// Held sediment released by Drucker-Prager after each rheology pass.
-    yield_release: bool,
+    hold: bool,
     dt_update: Stage,
     symplectic_predictor: Stage,
     symplectic_corrector: Stage,
@@ -76,7 +76,7 @@ impl SphPipeline {
         divisions: u32,
         verlet: bool,
         multiphase: bool,
-        yield_release: bool,
+        hold: bool,
     ) -> SphPipeline {
         let d = &gpu.device;
         let width = f64::from(2 * divisions + 1);
@@ -107,12 +107,12 @@ impl SphPipeline {
             ),
             forces_predict: Stage::new(
                 d,
-                &stages::FORCES_WCSPH,
+                &stages::INTERACTION,
                 &[stencil[0], stencil[1], ("REDUCE_DT", 1.0)],
             ),
             forces_correct: Stage::new(
                 d,
-                &stages::FORCES_WCSPH,
+                &stages::INTERACTION,
                 &[stencil[0], stencil[1], ("REDUCE_DT", 0.0)],
             ),
             rheology_predict: Stage::new(
@@ -127,16 +127,16 @@ impl SphPipeline {
             ),
             release_predict: Stage::new(
                 d,
-                &stages::YIELD_RELEASE,
+                &stages::HOLD,
                 &[stencil[0], stencil[1], ("BEFORE_DT", 1.0)],
             ),
             release_correct: Stage::new(
                 d,
-                &stages::YIELD_RELEASE,
+                &stages::HOLD,
                 &[stencil[0], stencil[1], ("BEFORE_DT", 0.0)],
             ),
             multiphase,
-            yield_release,
+            hold,
             dt_update: Stage::new(d, &stages::DT_UPDATE, &[]),
             symplectic_predictor: Stage::new(d, &stages::SYMPLECTIC_PREDICTOR, &[]),
             symplectic_corrector: Stage::new(d, &stages::SYMPLECTIC_CORRECTOR, &[]),
@@ -434,7 +434,7 @@ impl SphPipeline {
             (&self.rheology_correct, &b.rheology_correct)
         };
         self.record_active(pass, b, rheology, bind);
-        if self.yield_release {
+        if self.hold {
             let (release, bind) = if predict {
                 (&self.release_predict, &b.release_predict)
             } else {

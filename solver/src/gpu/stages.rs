@@ -178,9 +178,9 @@ pub const PARKED_COPY: StageSpec = StageSpec {
     workgroup: 128,
 };
 
-pub const FORCES_WCSPH: StageSpec = StageSpec {
-    name: "forces_wcsph",
-    shader: "stages/forces_wcsph.wgsl",
+pub const INTERACTION: StageSpec = StageSpec {
+    name: "interaction",
+    shader: "stages/interaction.wgsl",
     imports: NEIGHBOUR_PASS,
     bindings: &[
         ("params", 0, Uniform),
@@ -192,7 +192,7 @@ pub const FORCES_WCSPH: StageSpec = StageSpec {
         ("stress_a", 6, Texture),
         ("stress_b", 7, Texture),
     ],
-    entry_points: &["forces_wcsph"],
+    entry_points: &["interaction"],
     workgroup: 64,
 };
 
@@ -215,9 +215,9 @@ pub const RHEOLOGY: StageSpec = StageSpec {
     workgroup: 64,
 };
 
-pub const YIELD_RELEASE: StageSpec = StageSpec {
-    name: "yield_release",
-    shader: "stages/yield_release.wgsl",
+pub const HOLD: StageSpec = StageSpec {
+    name: "hold",
+    shader: "stages/hold.wgsl",
     imports: NEIGHBOUR_PASS,
     bindings: &[
         ("params", 0, Uniform),
@@ -230,7 +230,7 @@ pub const YIELD_RELEASE: StageSpec = StageSpec {
         ("regions", 7, ReadWrite),
         ("ids", 8, Read),
     ],
-    entry_points: &["yield_release"],
+    entry_points: &["hold"],
     workgroup: 64,
 };
 
@@ -371,9 +371,9 @@ pub const ALL: &[&StageSpec] = &[
     &ACTIVE_DISPATCH,
     &REORDER,
     &PARKED_COPY,
-    &FORCES_WCSPH,
+    &INTERACTION,
     &RHEOLOGY,
-    &YIELD_RELEASE,
+    &HOLD,
     &DT_UPDATE,
     &SYMPLECTIC_PREDICTOR,
     &SYMPLECTIC_CORRECTOR,

@@ -85,7 +85,7 @@ impl GpuBuffers {
             });
         }
         let max_groups = u64::from(gpu.limits.max_compute_workgroups_per_dimension);
-        if n_particles.div_ceil(u64::from(stages::FORCES_WCSPH.workgroup)) > max_groups
+        if n_particles.div_ceil(u64::from(stages::INTERACTION.workgroup)) > max_groups
             || (n_cells + 1).div_ceil(u64::from(stages::GRID_CLEAR.workgroup)) > max_groups
         {
             return Err(GpuError::TooLarge {

@@ -167,7 +167,7 @@ impl Simulation {
             divisions: divisions_of(case, derived.h),
             verlet: matches!(case.numerics.integrator, Integrator::Verlet { .. }),
             multiphase,
-            yield_release: multiphase && drucker_prager,
+            hold: multiphase && drucker_prager,
         };
         let engine: Box<dyn Engine> = match backend.into() {
             Backend::Gpu(gpu) => Box::new(GpuEngine::new(

@@ -40,7 +40,7 @@
 //!
 //! Held particles keep their viscous stress `2 mu eps` in the force pass: a moving neighbour is
 //! dragged by them as by the slow bed of the unheld model. The GPU's
-//! `shaders/stages/yield_release.wgsl` must give the same regions.
+//! `shaders/stages/hold.wgsl` must give the same regions.
 
 use super::drucker_prager::{alpha, kappa_c, yield_stress, yields};
 use super::pass::{ParticleRheology, SedimentModel, skeleton_pressure};

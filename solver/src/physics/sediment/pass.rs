@@ -1,7 +1,7 @@
 //! The rheology pass of the water-sediment model, brute force over all pairs: for every particle
 //! its strain rate, region and apparent viscosity, hence its viscous stress `tau = 2 mu eps`
 //! (Eqs. 11-15, 26-33, Figure 2); then the stress divergence of the momentum equation (Eq. 10).
-//! The GPU's `shaders/stages/rheology.wgsl` and the multiphase branch of `forces_wcsph.wgsl`
+//! The GPU's `shaders/stages/rheology.wgsl` and the multiphase branch of `interaction.wgsl`
 //! must give the same numbers (up to summation order).
 //!
 //! Choices the paper leaves open, each stated where it is made:

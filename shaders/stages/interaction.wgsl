@@ -251,7 +251,7 @@ fn particle_step(i: u32, o: Own, acc: vec3<f32>, visc_max: f32) -> f32 {
 }
 
 @compute @workgroup_size(64)
-fn forces_wcsph(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn interaction(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     // Dispatched over the active particles (cell_starts[n_cells]: parked ones sort after every
     // cell and are in no stencil), rounded up to whole workgroups.

@@ -26,7 +26,7 @@ fn held_in_rheology(i: u32) -> bool {
 }
 
 @compute @workgroup_size(64)
-fn yield_release(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn hold(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     let sd = params.sediment;
     // Over the active particles only, as the force pass.
