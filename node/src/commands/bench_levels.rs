@@ -210,25 +210,7 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         .steady(q, width)
     };
     let (n_low, n_high) = (with_n(0.8), with_n(1.2));
-    let q_unit = q / width;
-    let head = channel.weir.head_m(q_unit);
-    println!(
-        "1-D reference on the generated geometry: bed {:.4} m, crest {:.4} m ({:.3} m long), \
-         head {:.1} mm (H / L = {:.2}; a thin plate's, Rehbock: {:.1} mm), Strickler n = {:.4}, \
-         pit {:?} ({:.2} m behind a {:.3} m step); the flow's eddy viscosity kappa u* h / 6 = \
-         {:.2e} m2/s",
-        channel.bed_m,
-        channel.weir.crest_m,
-        channel.weir.length_m,
-        1e3 * head,
-        head / channel.weir.length_m,
-        1e3 * channel.weir.sharp_head_m(q_unit),
-        channel.manning_n,
-        channel.pit,
-        channel.weir.x_m - channel.x_bed_end_m,
-        channel.bed_m - channel.weir.floor_m,
-        channel.eddy_viscosity_m2_per_s(q, width),
-    );
+    print_reference(channel, q, width);
     let end = r.until_s;
     let mut table = Table::new([
         "gauge",
@@ -267,6 +249,30 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
         ]);
     }
     print!("{table}");
+}
+
+/// The 1-D reference's geometry, weir, friction, pit and eddy viscosity at discharge `q`
+/// (m3/s) over `width` (m).
+fn print_reference(channel: &Channel, q: f64, width: f64) {
+    let q_unit = q / width;
+    let head = channel.weir.head_m(q_unit);
+    println!(
+        "1-D reference on the generated geometry: bed {:.4} m, crest {:.4} m ({:.3} m long), \
+         head {:.1} mm (H / L = {:.2}; a thin plate's, Rehbock: {:.1} mm), Strickler n = {:.4}, \
+         pit {:?} ({:.2} m behind a {:.3} m step); the flow's eddy viscosity kappa u* h / 6 = \
+         {:.2e} m2/s",
+        channel.bed_m,
+        channel.weir.crest_m,
+        channel.weir.length_m,
+        1e3 * head,
+        head / channel.weir.length_m,
+        1e3 * channel.weir.sharp_head_m(q_unit),
+        channel.manning_n,
+        channel.pit,
+        channel.weir.x_m - channel.x_bed_end_m,
+        channel.bed_m - channel.weir.floor_m,
+        channel.eddy_viscosity_m2_per_s(q, width),
+    );
 }
 
 fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
