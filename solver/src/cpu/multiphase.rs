@@ -11,7 +11,7 @@
 //! concentration one, and it stays held with the viscosity its own density gives. That is
 //! what [`Rheology::finish`] gives from the particle's own start, to the bit, without the
 //! neighbour loop; its neighbours read only its position, velocity and density, which the
-//! pass does not change.
+//! pass does not change. A wall, whose rheology is none, is spared the walk as well.
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
@@ -37,8 +37,8 @@ pub struct Holds<'a> {
     pub awake_set: bool,
 }
 
-/// The rheology of the active particles, and how many grains were spared the walk over their
-/// neighbours.
+/// The rheology of the active particles, and how many of them (sleeping grains and walls) were
+/// spared the walk over their neighbours.
 pub struct RheologyPass {
     pub out: Vec<ParticleRheology>,
     pub asleep: usize,
@@ -175,13 +175,17 @@ impl Pairs<'_> {
         let mut start = first;
         while start < end {
             let group = grid.group(start, end, |k| self.sides[k].x);
-            // A group with an awake grain is walked whole: a sleeper's sums give it what its
-            // start does.
-            if group.range.clone().all(|i| self.asleep[i]) {
+            // A group with an awake grain or a moving particle is walked whole: a sleeper's
+            // sums give it what its start does, and a wall's rheology is none whatever its
+            // neighbours.
+            let spared =
+                |i: usize| self.asleep[i] || !self.params.phases[phase_index(&pos[i])].mobile;
+            if group.range.clone().all(spared) {
                 asleep += group.range.len();
                 for i in group.range.clone() {
                     let s = pass.start(&pos[i], &vel[i]);
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, true, self.ids[i]);
+                    let held = held_before[i];
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, held, self.ids[i]);
                 }
             } else {
                 let sums = self.group(&group);
@@ -206,13 +210,6 @@ impl Pairs<'_> {
             pass.start(&pos[i], &vel[i])
         });
         let mut sums = RheologySums::lanes(&starts);
-        // A wall's rheology is none whatever its neighbours.
-        if !range
-            .clone()
-            .any(|i| self.params.phases[phase_index(&pos[i])].mobile)
-        {
-            return sums;
-        }
         let side = RheologySide::lanes(&self.sides[range]);
         let reach = grid.reach();
         grid.row_span(group.cell, group.last_x(), |range, x| {
