@@ -69,7 +69,10 @@ fn held_here(i: u32) -> bool {
 override REDUCE_DT: bool = true;
 
 // Particle i as its neighbour sums read it: position (phase in w), velocity, density, phase,
-// whether it moves (held sand standing as a wall does not), its momentum pressure over rho^2,
+// whether it moves (held sand standing as a wall does not), whether it is held fixed where it
+// stands (the Shields-only mode's held sand where it is not a wall: only its density rate is
+// summed, and it does not bound the step; `Side::fixed` in interaction/mod.rs), its momentum
+// pressure over rho^2,
 // rest density, Tait coefficient, viscosity and stress over rho^2; whether held sand is a wall
 // and the reach of its contact force, squared.
 struct Own {
@@ -78,6 +81,7 @@ struct Own {
     rho: f32,
     phase: u32,
     mobile: bool,
+    fixed: bool,
     press: f32,
     rho0: f32,
     b: f32,
@@ -99,7 +103,11 @@ fn own(i: u32) -> Own {
     if (o.bed_walls) {
         o.bed_r0_2 = bed_contact_r0_2();
     }
-    o.mobile = params.phases[o.phase].mobile > 0.5 && !(o.bed_walls && held_here(i));
+    let held = held_here(i);
+    o.mobile = params.phases[o.phase].mobile > 0.5 && !(o.bed_walls && held);
+    // Only the Shields-only mode's holds: a Drucker-Prager hold may be released after the
+    // rheology pass wrote this word (hold.wgsl).
+    o.fixed = o.mobile && held && !o.bed_walls && params.sediment.shields_only != 0u;
     o.press = momentum_pressure(o.rho, o.phase) / (o.rho * o.rho);
     o.rho0 = params.phases[o.phase].rho0;
     o.b = params.tait_b[o.phase];
@@ -214,13 +222,17 @@ fn add_neighbour(sums: ptr<function, Sums>, o: Own, j: u32) {
         }
         return;
     }
-    // Only held sand is a wall of a mobile phase.
-    if (o.bed_walls && !n.mobile && params.phases[n.phase].mobile > 0.5 && n.phase != o.phase) {
-        (*sums).acc += bed_contact(n.r2, o.bed_r0_2) * n.dx;
-    }
     if (params.diffusion_mode != 0u && n.mobile && n.phase == o.phase) {
         let dz = o.pos[params.vertical_axis] - pos_j[params.vertical_axis];
         (*sums).drho += diffusion_rate(o, n, dz);
+    }
+    // A fixed particle's acceleration is never read.
+    if (o.fixed) {
+        return;
+    }
+    // Only held sand is a wall of a mobile phase.
+    if (o.bed_walls && !n.mobile && params.phases[n.phase].mobile > 0.5 && n.phase != o.phase) {
+        (*sums).acc += bed_contact(n.r2, o.bed_r0_2) * n.dx;
     }
     n.press = momentum_pressure(vr_j.w, n.phase) / (n.rho * n.rho);
     n.mu_ij = h * n.vdotr / (n.r2 + params.eta2);
@@ -270,10 +282,10 @@ fn interaction(@builtin(global_invocation_id) gid: vec3<u32>) {
     var dt_i = 3.0e38;
     var acc = vec3<f32>(0.0);
     var drho = sums.drho;
-    if (o.mobile) {
+    if (o.mobile && !o.fixed) {
         acc = sums.acc + params.gravity.xyz;
         dt_i = particle_step(i, o, acc, sums.visc_max);
-    } else if (params.boundary_mode == BOUNDARY_GENERALISED) {
+    } else if (!o.mobile && params.boundary_mode == BOUNDARY_GENERALISED) {
         // The wall's density in place of its rate.
         drho = generalised_wall_density(sums, o.rho0, o.b);
     }

@@ -58,17 +58,20 @@ impl CpuEngine {
         let model = PairModel::new(&self.model);
         let store = Store::new(&self.params, &self.model);
         let bed_walls = self.bed_is_boundary();
+        let shields_only = self.params.sediment.shields_only != 0;
         let (sides, imposed): (Vec<Side>, Vec<bool>) = self.pool.install(|| {
             (0..active)
                 .into_par_iter()
                 .map(|i| {
                     let imposed = store.velocity_imposed(&pos[i]);
                     let side = model.side(&pos[i], &vel[i]);
-                    // The held bed stands as a wall does (`physics::boundary`).
-                    let wall = bed_walls && rheology.as_ref().is_some_and(|r| r[i].held);
+                    // The Shields-only mode's held bed stands as a wall does
+                    // (`physics::boundary`), or is fixed where it stands.
+                    let held = rheology.as_ref().is_some_and(|r| r[i].held);
                     let side = Side {
                         imposed,
-                        mobile: side.mobile && !wall,
+                        mobile: side.mobile && !(bed_walls && held),
+                        fixed: side.mobile && held && !bed_walls && shields_only,
                         ..side
                     };
                     (side, imposed)

@@ -511,6 +511,15 @@ fn check_rheology_round(
             f[k] += s[k];
         }
     }
+    // The Shields-only mode's held sand is fixed where it stands (these cases' walls are
+    // DBC): the backends sum only its density rate, give it no acceleration and let it not
+    // bound the step (`interaction::Side::fixed`).
+    for ((f, dt), r) in cpu.forces.iter_mut().zip(&mut cpu.dt_limit).zip(&rheology) {
+        if r.held && model.shields_only {
+            f[..3].fill(0.0);
+            *dt = f32::INFINITY;
+        }
+    }
     let dim = params.dim as usize;
     assert_close(
         "multiphase acceleration",

@@ -74,6 +74,12 @@ pub struct Side<L: Real = f32> {
     /// Moved at an imposed velocity (an inlet buffer): its density is not the flow's, and a
     /// wall under the generalised condition does not count it (`physics::boundary`).
     pub imposed: bool,
+    /// Held fixed where it stands (the Shields-only mode's held sediment where it is not a
+    /// wall, as under DBC): its acceleration is never used, so only its density rate is
+    /// summed, and it does not bound the step, as the paper fixes it ("explicitly setting the
+    /// velocity and acceleration to zero"). A Drucker-Prager hold may be released after the
+    /// rheology pass, and is summed in full.
+    pub fixed: L::Mask,
 }
 
 impl Side<Lanes> {
@@ -94,6 +100,7 @@ impl Side<Lanes> {
             out.mass.0[k] = s.mass;
             out.mu.0[k] = s.mu;
             out.hydro.0[k] = s.hydro;
+            out.fixed.0[k] = if s.fixed { u32::MAX } else { 0 };
         })
     }
 }
@@ -251,6 +258,7 @@ impl<'a> PairModel<'a> {
             mu: ph.mu,
             hydro: ph.hydro,
             imposed: false,
+            fixed: false,
         }
     }
 
@@ -300,15 +308,20 @@ impl<'a> PairModel<'a> {
         if !near.any() {
             return None;
         }
-        if !j.mobile && self.contact_d > 0.0 && self.phase(j.phase).mobile {
-            let other = near & !L::index_eq(i.phase, j.phase);
-            self.add_contact(j, x_ij, r2, other, sum);
-        }
         if params.delta > 0.0 && j.mobile {
             // Same phase, not a wall: j's own mass and density, hence its own volume.
             let same = near & L::index_eq(i.phase, j.phase);
             let term = s(self.delta_h_c0) * self.diffusion(i, j, r2, f) * s(j.vol);
             sum.drho = L::select(same, sum.drho + term, sum.drho);
+        }
+        // A fixed particle's acceleration is never read: the rest is for the others.
+        let near = near & !i.fixed;
+        if !near.any() {
+            return None;
+        }
+        if !j.mobile && self.contact_d > 0.0 && self.phase(j.phase).mobile {
+            let other = near & !L::index_eq(i.phase, j.phase);
+            self.add_contact(j, x_ij, r2, other, sum);
         }
         // Pressure gradient, Eq. 10 with sigma = -p I.
         let mut coef = -m_j * (i.p_over_rho2 + p_j);
@@ -419,13 +432,13 @@ impl<'a> PairModel<'a> {
         s(2.0) * (s(j.rho) - i.rho - rho_h) * (-r2 * f) / (r2 + s(self.eta2))
     }
 
-    /// Particle `i`'s `[ax, ay, az, d rho/dt]` (gravity added; zero acceleration for a wall)
-    /// and its stable step before the CFL factor, `min(sqrt(h / |a|), h / (c0 + visc_max))`
-    /// (`f32::INFINITY` for a wall); without `force_bound` (an imposed velocity) the
-    /// acceleration does not bound the step.
+    /// Particle `i`'s `[ax, ay, az, d rho/dt]` (gravity added; zero acceleration for a wall
+    /// or a fixed particle) and its stable step before the CFL factor, `min(sqrt(h / |a|), h /
+    /// (c0 + visc_max))` (`f32::INFINITY` for a wall or a fixed particle); without
+    /// `force_bound` (an imposed velocity) the acceleration does not bound the step.
     pub fn finish(&self, i: &Side, sum: &PairSum, force_bound: bool) -> ([f32; 4], f32) {
         let params = self.params;
-        if !i.mobile {
+        if !i.mobile || i.fixed {
             return ([0.0, 0.0, 0.0, sum.drho], f32::INFINITY);
         }
         let mut acc = sum.acc;

@@ -90,6 +90,42 @@ fn two_particles_by_hand() {
 }
 
 #[test]
+fn a_fixed_particle_sums_its_density_rate_only() {
+    // The pair of `two_particles_by_hand` with diffusion: particle i held fixed keeps the
+    // density rate it had (continuity 0.034_815_12 and the diffusion towards j), takes no
+    // acceleration and does not bound the step; j, free, feels i in full.
+    let mut params = params_2d(1.0, 10.0, 1.0);
+    params.gravity = [0.0; 3];
+    params.delta = 0.1;
+    let model = PairModel::new(&params);
+    let (p_i, p_j) = (at(1.0, 0.0, WATER), at(0.0, 0.0, WATER));
+    let (v_i, v_j) = ([-0.1, 0.0, 0.0, 1010.0], [0.0, 0.0, 0.0, 1000.0]);
+    let free = model.side(&p_i, &v_i);
+    let fixed = Side {
+        fixed: true,
+        ..free.clone()
+    };
+    let j = model.side(&p_j, &v_j);
+    let sums = |i: &Side| {
+        let mut sum = PairSum::default();
+        model.add_pair(i, &j, true, &mut sum);
+        model.finish(i, &sum, true)
+    };
+    let ((f_free, dt_free), (f_fixed, dt_fixed)) = (sums(&free), sums(&fixed));
+    assert_eq!(f_fixed[3], f_free[3]);
+    assert!(f_free[3] != 0.034_815_12 && f_free[0] != 0.0, "{f_free:?}");
+    assert_eq!(f_fixed[..3], [0.0; 3]);
+    assert!(dt_free.is_finite() && dt_fixed == f32::INFINITY);
+    // j's sums read i's position, velocity and density only: the same either way.
+    let of_j = |i: &Side| {
+        let mut sum = PairSum::default();
+        model.add_pair(&j, i, true, &mut sum);
+        model.finish(&j, &sum, true)
+    };
+    assert_eq!(of_j(&fixed), of_j(&free));
+}
+
+#[test]
 fn lonely_particle_falls() {
     let params = params_2d(0.02, 20.0, 0.4);
     let out = interact(&params, &[at(0.0, 0.0, WATER)], &[[0.0, 0.0, 0.0, 1000.0]]);
