@@ -136,37 +136,10 @@ impl<'a> Store<'a> {
     ) -> (Particle, Event) {
         let phase = self.phase(p);
         let (x, v) = moved;
-        if let (Some(f), true) = (self.flume, phase.mobile) {
-            let kind = p[3].to_bits();
-            let sediment = self.params.sediment.phase;
-            let is_sediment = sediment != 0 && kind == sediment;
-            if x[0] > f.outlet_x {
-                return self.park(f, id, is_sediment);
-            }
-            if is_sediment
-                && x[0] >= f.collector_x_min
-                && x[0] <= f.collector_x_max
-                && x[1] < f.collector_y_max
-            {
-                return self.park(f, id, true);
-            }
-            if kind == f.water_phase && Self::in_inlet(f, p) {
-                // Imposed velocity, at the density it entered with (or its own, see below).
-                let rho = self.inlet_density(phase, vr[3], v[3]);
-                return self.checked(
-                    phase,
-                    [p[0] + dt * f.inlet_u, p[1], p[2], p[3]],
-                    [f.inlet_u, 0.0, 0.0, rho],
-                );
-            }
-            if kind == f.water_phase && Self::in_duct(f, p) {
-                let rho = self.clamped(phase, v[3]);
-                return self.checked(
-                    phase,
-                    [p[0] + dt * f.duct_u, p[1], p[2], p[3]],
-                    [f.duct_u, 0.0, 0.0, rho],
-                );
-            }
+        if let (Some(f), true) = (self.flume, phase.mobile)
+            && let Some(stored) = self.flume_zones(f, id, (p, vr), dt, (x, v))
+        {
+            return stored;
         }
         if !phase.mobile {
             // Walls keep position and velocity and rho >= rho0 (the integrator saw to it);
@@ -206,6 +179,50 @@ impl<'a> Store<'a> {
             return (parked, event);
         }
         self.checked(phase, x, [v[0], v[1], v[2], rho])
+    }
+
+    /// Particle `id` of a mobile phase stored where the open flume `f` treats it apart: past the
+    /// outlet, sediment in the collector, water in the inlet buffer or a duct; None elsewhere.
+    fn flume_zones(
+        &self,
+        f: &FlumeGpu,
+        id: u32,
+        (p, vr): (&[f32; 4], &[f32; 4]),
+        dt: f32,
+        (x, v): Particle,
+    ) -> Option<(Particle, Event)> {
+        let phase = self.phase(p);
+        let kind = p[3].to_bits();
+        let sediment = self.params.sediment.phase;
+        let is_sediment = sediment != 0 && kind == sediment;
+        if x[0] > f.outlet_x {
+            return Some(self.park(f, id, is_sediment));
+        }
+        if is_sediment
+            && x[0] >= f.collector_x_min
+            && x[0] <= f.collector_x_max
+            && x[1] < f.collector_y_max
+        {
+            return Some(self.park(f, id, true));
+        }
+        if kind == f.water_phase && Self::in_inlet(f, p) {
+            // Imposed velocity, at the density it entered with (or its own, see below).
+            let rho = self.inlet_density(phase, vr[3], v[3]);
+            return Some(self.checked(
+                phase,
+                [p[0] + dt * f.inlet_u, p[1], p[2], p[3]],
+                [f.inlet_u, 0.0, 0.0, rho],
+            ));
+        }
+        if kind == f.water_phase && Self::in_duct(f, p) {
+            let rho = self.clamped(phase, v[3]);
+            return Some(self.checked(
+                phase,
+                [p[0] + dt * f.duct_u, p[1], p[2], p[3]],
+                [f.duct_u, 0.0, 0.0, rho],
+            ));
+        }
+        None
     }
 
     /// Parks particle `id` at its spot as water; eroded when it was sediment.

@@ -103,7 +103,7 @@ fn a_fixed_particle_sums_its_density_rate_only() {
     let free = model.side(&p_i, &v_i);
     let fixed = Side {
         fixed: true,
-        ..free.clone()
+        ..free
     };
     let j = model.side(&p_j, &v_j);
     let sums = |i: &Side| {
