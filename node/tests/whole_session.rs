@@ -12,8 +12,8 @@ use std::process::Command;
 const SESSION_S: f64 = 75.0;
 /// Each predicted level against the measured one from [`STEADY_FROM_S`] on, m: 1.5 dp. The
 /// session's "measurements" are the 1-D reference of `flume_solver::hydraulics`; the CI-size
-/// twin stands 5-8 mm over them at P1-P3 (the grains the front leaves perched on the bed, README,
-/// levels section), 10.5 mm at worst. The case's own choices (DBC walls, alpha = 0.02, the
+/// twin stands 5-8 mm over them at P1-P3 (the bed the front's pick-ups leave a dp rough, holes and
+/// perched grains alike: README, levels section), 10.5 mm at worst. The case's own choices (DBC walls, alpha = 0.02, the
 /// release at once) stood 2-3 cm over and rose to the end, and fail it.
 const LEVEL_TOLERANCE_M: f64 = 0.015;
 /// RMS of each gauge's residual once the flume has filled ([`FILLED_FROM_S`]), m. Measured:
