@@ -193,17 +193,23 @@ pub fn generate(case: &Case, derived: &Derived) -> Particles {
                 push(&p, water, rho0, &mut out);
             }
         }
-        let parking = Parking::new(case, derived.h);
-        let parked = parked_phase(case);
-        for _ in 0..f.reservoir_particles {
-            let id = out.positions.len() as u32;
-            let [x, y] = parking.spot(id);
-            out.ids.push(id);
-            out.positions.push([x, y, 0.0, f32::from_bits(parked)]);
-            out.vel_rho.push([0.0, 0.0, 0.0, rho0 as f32]);
-        }
+        park_reservoir(case, derived, f.reservoir_particles, rho0, &mut out);
     }
     out
+}
+
+/// Appends the open flume's `count` parked particles, each at its own spot above the flume at
+/// the water's rest density `rho0`.
+fn park_reservoir(case: &Case, derived: &Derived, count: u32, rho0: f64, out: &mut Particles) {
+    let parking = Parking::new(case, derived.h);
+    let parked = parked_phase(case);
+    for _ in 0..count {
+        let id = out.positions.len() as u32;
+        let [x, y] = parking.spot(id);
+        out.ids.push(id);
+        out.positions.push([x, y, 0.0, f32::from_bits(parked)]);
+        out.vel_rho.push([0.0, 0.0, 0.0, rho0 as f32]);
+    }
 }
 
 /// Lattice points of the inlet buffer at the start: `layers` columns next to the upstream

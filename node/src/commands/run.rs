@@ -120,15 +120,7 @@ async fn serve(
         full(topics::INFLOW),
         gauge_names.len()
     );
-    let options = Options {
-        gauge_names: gauge_names.clone(),
-        node_name: node_path,
-        wait_for_sensors,
-        max_chunk_s: args.max_chunk_s,
-        until: args.until,
-        cloud_rate_hz: args.cloud_rate_hz,
-        cloud_max_points: args.cloud_max_points,
-    };
+    let options = twin_options(args, gauge_names.clone(), node_path, wait_for_sensors);
     let mut twin = Twin::new(options, limits, settings, solver.link);
     let mut wire = Wire {
         node: &node,
@@ -151,6 +143,24 @@ async fn serve(
     // Closing the solver's channel: it finishes its chunk and stops.
     drop(twin);
     wind_down(wire, solver.handle, args.out.clone(), case_name).await
+}
+
+/// The live twin's options from the command line.
+fn twin_options(
+    args: &RunArgs,
+    gauge_names: Vec<String>,
+    node_name: String,
+    wait_for_sensors: bool,
+) -> Options {
+    Options {
+        gauge_names,
+        node_name,
+        wait_for_sensors,
+        max_chunk_s: args.max_chunk_s,
+        until: args.until,
+        cloud_rate_hz: args.cloud_rate_hz,
+        cloud_max_points: args.cloud_max_points,
+    }
 }
 
 /// Closes the recording and the viewer, waits for the solver thread, and draws the plots
