@@ -104,6 +104,13 @@ fn held_bed_is_wall() -> bool {
         && sd.shields_only != 0u;
 }
 
+// A free particle's density as stored: without tension (the case's clamp_negative_pressure)
+// never below its phase's rest, so that a sheet too thin for a full kernel does not thin out
+// without end.
+fn clamped_density(rho: f32, phase: u32) -> f32 {
+    return select(rho, max(rho, params.phases[phase].rho0), params.clamp_pressure != 0u);
+}
+
 // An inlet buffer particle's density: the one it entered with, or under the generalised wall
 // condition its own by continuity, without tension (cpu/store.rs, inlet_density).
 fn inlet_density(entered: f32, integrated: f32, phase: u32) -> f32 {

@@ -71,9 +71,7 @@ fn store_rule(id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, 
     let phase = bitcast<u32>(p.w);
     let ph = params.phases[phase];
     let f = params.flume;
-    // Without tension (the case's clamp_negative_pressure) the density never falls below
-    // rest: a sheet too thin for a full kernel would otherwise thin out without end.
-    let clamped = select(rho, max(rho, ph.rho0), params.clamp_pressure != 0u);
+    let clamped = clamped_density(rho, phase);
     if (ph.mobile <= 0.5) {
         return Stored(STORED_KEPT, p, vec4<f32>(vr.xyz, max(rho, ph.rho0)), 0u);
     }

@@ -40,7 +40,6 @@ fn store_state(i: u32, id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: ve
     }
     if (s.fate == STORED_EXCLUDED) {
         let phase = bitcast<u32>(p.w);
-        let rho0 = params.phases[phase].rho0;
-        log_excluded(id, phase, x, v, select(rho, max(rho, rho0), params.clamp_pressure != 0u));
+        log_excluded(id, phase, x, v, clamped_density(rho, phase));
     }
 }

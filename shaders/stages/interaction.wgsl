@@ -103,7 +103,8 @@ fn own(i: u32) -> Own {
     if (o.bed_walls) {
         o.bed_r0_2 = bed_contact_r0_2();
     }
-    let held = held_here(i);
+    // The hold matters to a wall of held sand and to the Shields-only mode's fixed sand only.
+    let held = (o.bed_walls || params.sediment.shields_only != 0u) && held_here(i);
     o.mobile = params.phases[o.phase].mobile > 0.5 && !(o.bed_walls && held);
     // Only the Shields-only mode's holds: a Drucker-Prager hold may be released after the
     // rheology pass wrote this word (hold.wgsl).

@@ -44,7 +44,7 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
         textureStore(vel_rho_half, texel(i), vec4<f32>(0.0, 0.0, 0.0, r));
     } else if (params.phases[phase].mobile > 0.5) {
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * vr.xyz, p.w));
-        let r = select(rho, max(rho, params.phases[phase].rho0), params.clamp_pressure != 0u);
+        let r = clamped_density(rho, phase);
         textureStore(vel_rho_half, texel(i), vec4<f32>(vr.xyz + half_dt * f.xyz, r));
     } else {
         textureStore(positions_half, texel(i), p);

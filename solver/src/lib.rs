@@ -67,4 +67,4 @@ pub mod particles;
 pub mod simulation;
 /// The CPU backend's end of a step, which `tests/wgsl_store.rs` holds `store_rule.wgsl` to.
 #[doc(hidden)]
-pub use cpu::store::{Event as StoreEvent, Store};
+pub use cpu::store::Store;

@@ -22,9 +22,9 @@ use flume_solver::{Case, Store};
 const DT: f32 = 0.01;
 
 /// The WGSL side: `a` = (x, y, new density, phase bits), `b` = (u, v, old density, held +
-/// 2 id); the old velocity is half the new, the free new position x + DT v.
+/// 2 id); the old velocity is half the new, the free new position x + DT v. `DT` is defined
+/// before it from the Rust constant.
 const STORE_PROBE: &str = "
-const DT: f32 = 0.01;
 fn store_probe(a: vec4<f32>, b: vec4<f32>) -> Stored {
     let p = vec4<f32>(a.x, a.y, 0.0, a.w);
     let code = u32(b.w);
@@ -123,6 +123,7 @@ fn agree_on(probe: &Probe, fates: &[f32]) {
     let helpers = [
         shader::source("common/flume.wgsl"),
         shader::source("common/store_rule.wgsl"),
+        &format!("const DT: f32 = {DT:?};"),
         STORE_PROBE,
     ]
     .concat();
