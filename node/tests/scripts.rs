@@ -163,3 +163,37 @@ fn bed_load_names_what_it_cannot_read() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `figure10_chart.py` draws each ks/d50's mean as the bar and the runs' range as the whisker,
+/// on the paper's axis to 3 kg/m unless a run goes over. By hand, for a plot 320 px high from
+/// y = 40: runs of 0.5 and 1.0 kg/m give a bar to 0.75 (y = 40 + 320 (1 - 0.75 / 3) = 280.0)
+/// and a whisker from 0.5 (306.7) to 1.0 (253.3); a run of 4.2 kg/m stretches the axis to 4.5.
+#[test]
+fn figure10_chart_draws_the_mean_and_the_range_of_the_runs() {
+    let dir = std::env::temp_dir().join(format!("flume-fig10-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let chart = |rows: &str| {
+        let path = dir.join("runs.csv");
+        std::fs::write(&path, format!("ks_over_d50,eroded_kg_per_m\n{rows}")).expect("csv");
+        Command::new("python3")
+            .arg(repo_file("scripts/figure10_chart.py"))
+            .arg(format!("runs={}", path.display()))
+            .output()
+            .expect("python3 runs")
+    };
+    let out = chart("3,0.5\n3,1.0\n");
+    let svg = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bar = svg.lines().find(|l| l.contains("fill=\"#9e9e9e\"/>"));
+    assert!(bar.is_some_and(|l| l.contains("y=\"280.0\"")), "{svg}");
+    assert!(svg.contains("y1=\"306.7\" y2=\"253.3\""), "{svg}");
+    assert!(!svg.contains(">3.5<"), "{svg}");
+    let out = chart("3,4.2\n");
+    let svg = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(svg.contains(">4.5<") && !svg.contains(">5<"), "{svg}");
+    let out = chart("3,lots\n");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("not a ladder of runs"), "{err}");
+    assert!(!err.contains("Traceback"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
