@@ -183,7 +183,11 @@ fn figure10_chart_draws_the_mean_and_the_range_of_the_runs() {
     };
     let out = chart("3,0.5\n3,1.0\n");
     let svg = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let bar = svg.lines().find(|l| l.contains("fill=\"#9e9e9e\"/>"));
     assert!(bar.is_some_and(|l| l.contains("y=\"280.0\"")), "{svg}");
     assert!(svg.contains("y1=\"306.7\" y2=\"253.3\""), "{svg}");
@@ -193,7 +197,10 @@ fn figure10_chart_draws_the_mean_and_the_range_of_the_runs() {
     assert!(svg.contains(">4.5<") && !svg.contains(">5<"), "{svg}");
     let out = chart("3,lots\n");
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("not a ladder of runs"), "{err}");
+    assert!(
+        !out.status.success() && err.contains("not a ladder of runs"),
+        "{err}"
+    );
     assert!(!err.contains("Traceback"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -109,7 +109,10 @@ pub fn force_pass(
             .zip(dt_limit.par_chunks_mut(BLOCK))
             .enumerate()
             .map(|(block, (forces, dt_limit))| {
-                simd::dispatch(|| pass.block(block * BLOCK, forces, dt_limit))
+                simd::dispatch(
+                    #[inline(always)]
+                    || pass.block(block * BLOCK, forces, dt_limit),
+                )
             })
             .sum()
     })
@@ -210,23 +213,28 @@ impl Pass<'_> {
             let mine = StressSide::lanes(&stress[group.range.clone()]);
             (div, stress, mine)
         });
-        grid.row_span(group.cell, group.last_x(), |range, x| {
-            let near = group.near(x, reach);
-            match &stress {
-                None => {
-                    for j in range {
-                        model.add_pair(&side, &sides[j], near, &mut sum);
+        grid.row_span(
+            group.cell,
+            group.last_x(),
+            #[inline(always)]
+            |range, x| {
+                let near = group.near(x, reach);
+                match &stress {
+                    None => {
+                        for j in range {
+                            model.add_pair(&side, &sides[j], near, &mut sum);
+                        }
                     }
-                }
-                Some((div, stress, stress_i)) => {
-                    for j in range {
-                        if let Some(g) = model.add_pair(&side, &sides[j], near, &mut sum) {
-                            div.add_term(stress_i, &stress[j], &g, &mut tau);
+                    Some((div, stress, stress_i)) => {
+                        for j in range {
+                            if let Some(g) = model.add_pair(&side, &sides[j], near, &mut sum) {
+                                div.add_term(stress_i, &stress[j], &g, &mut tau);
+                            }
                         }
                     }
                 }
-            }
-        });
+            },
+        );
         (sum, tau)
     }
 

@@ -93,7 +93,12 @@ pub fn rheology_pass(
     let asleep = pool.install(|| {
         out.par_chunks_mut(BLOCK)
             .enumerate()
-            .map(|(b, out)| simd::dispatch(|| pairs.block(b * BLOCK, out, held_before)))
+            .map(|(b, out)| {
+                simd::dispatch(
+                    #[inline(always)]
+                    || pairs.block(b * BLOCK, out, held_before),
+                )
+            })
             .sum()
     });
     if release {
@@ -212,12 +217,23 @@ impl Pairs<'_> {
         let mut sums = RheologySums::lanes(&starts);
         let side = RheologySide::lanes(&self.sides[range]);
         let reach = grid.reach();
-        grid.row_span(group.cell, group.last_x(), |range, x| {
-            let near = group.near(x, reach);
-            for j in range {
-                pass.add_pair_of_volume(&side, (&pos[j], &vel[j]), self.vol[j], near, &mut sums);
-            }
-        });
+        grid.row_span(
+            group.cell,
+            group.last_x(),
+            #[inline(always)]
+            |range, x| {
+                let near = group.near(x, reach);
+                for j in range {
+                    pass.add_pair_of_volume(
+                        &side,
+                        (&pos[j], &vel[j]),
+                        self.vol[j],
+                        near,
+                        &mut sums,
+                    );
+                }
+            },
+        );
         sums
     }
 }

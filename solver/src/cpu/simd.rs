@@ -2,7 +2,11 @@
 //! for the baseline of its target (SSE2 on x86-64, four f32 a register), so a pass that runs
 //! inside [`dispatch`] is compiled a second time for AVX2 (eight) and that copy runs where
 //! the CPU has it. Both copies do the same IEEE operations lane by lane: the results are the
-//! same to the bit on either. (A third copy for AVX-512F/VL, the same eight lanes with twice
+//! same to the bit on either. Only what LLVM inlines into [`avx2`] is in the AVX2 copy: a
+//! function it keeps apart is compiled once, for the baseline. So the closure handed to
+//! [`dispatch`] is `#[inline(always)]`, and so is the visitor a pass hands the cell list
+//! (`Grid::row_span`): until both were, the force pass's pair loops ran on four lanes (16 % of
+//! the CI flume's time in one function of SSE code). (A third copy for AVX-512F/VL, the same eight lanes with twice
 //! the registers, ran the CI flume 30 % slower here: it is not built.)
 
 /// Runs `f`, compiled for AVX2 where the CPU has it.
