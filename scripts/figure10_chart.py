@@ -53,17 +53,22 @@ def parse_args(argv):
     return ladders
 
 
+class Frame:
+    """The plot's scale: the y axis to `top` kg/m, a slot per ks/d50 value."""
+
+    def __init__(self, top, slots):
+        self.top = top
+        self.plot_w, self.plot_h = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
+        self.slot = self.plot_w / slots
+
+    def y(self, v):
+        return TOP + self.plot_h * (1 - v / self.top)
+
+
 def svg(ladders):
     ks_values = sorted({k for _, runs in ladders for k in runs})
     top = max([PAPER_AXIS_KG_PER_M] + [max(v) for _, r in ladders for v in r.values()])
-    top = float(int(top * 2 + 0.999)) / 2
-    plot_w, plot_h = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
-    slot = plot_w / len(ks_values)
-    bar = slot * 0.7 / len(ladders)
-
-    def y(v):
-        return TOP + plot_h * (1 - v / top)
-
+    frame = Frame(float(int(top * 2 + 0.999)) / 2, len(ks_values))
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" '
         'font-family="sans-serif" font-size="12">',
@@ -71,23 +76,39 @@ def svg(ladders):
         f'<text x="{WIDTH / 2}" y="20" text-anchor="middle" font-size="14">'
         "Eroded mass collected at 18 s against ks/d50 (ULBRA flume, dp = 4 mm)</text>",
     ]
-    for k in range(int(top * 2) + 1):
-        v = k / 2
-        axis_top = v == PAPER_AXIS_KG_PER_M
-        style = 'stroke="#555" stroke-dasharray="6 4"' if axis_top else 'stroke="#ddd"'
-        out.append(
-            f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{y(v):.1f}" y2="{y(v):.1f}" {style}/>'
-        )
-        out.append(f'<text x="{LEFT - 8}" y="{y(v) + 4:.1f}" text-anchor="end">{v:g}</text>')
+    out += grid_lines(frame)
     if 3.0 in ks_values:
-        x0 = LEFT + slot * ks_values.index(3.0) + slot * 0.1
+        x0 = LEFT + frame.slot * ks_values.index(3.0) + frame.slot * 0.1
         lo, hi = AIM_AT_KS3
         out.append(
-            f'<rect x="{x0:.1f}" y="{y(hi):.1f}" width="{slot * 0.8:.1f}" '
-            f'height="{y(lo) - y(hi):.1f}" fill="#2ca02c" fill-opacity="0.12"/>'
+            f'<rect x="{x0:.1f}" y="{frame.y(hi):.1f}" width="{frame.slot * 0.8:.1f}" '
+            f'height="{frame.y(lo) - frame.y(hi):.1f}" fill="#2ca02c" fill-opacity="0.12"/>'
         )
+    out += bars(frame, ks_values, ladders)
+    out += labels(frame, ks_values, ladders)
+    out.append("</svg>")
+    return "\n".join(out) + "\n"
+
+
+def grid_lines(frame):
+    """A line and a label every 0.5 kg/m, the paper's axis top dashed."""
+    out = []
+    for k in range(int(frame.top * 2) + 1):
+        v, y = k / 2, frame.y(k / 2)
+        axis_top = v == PAPER_AXIS_KG_PER_M
+        style = 'stroke="#555" stroke-dasharray="6 4"' if axis_top else 'stroke="#ddd"'
+        out.append(f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{y:.1f}" y2="{y:.1f}" {style}/>')
+        out.append(f'<text x="{LEFT - 8}" y="{y + 4:.1f}" text-anchor="end">{v:g}</text>')
+    return out
+
+
+def bars(frame, ks_values, ladders):
+    """Each ks/d50's label, and per ladder its runs' mean as a bar and their range as a
+    whisker."""
+    out = []
+    width = frame.slot * 0.7 / len(ladders)
     for i, ks in enumerate(ks_values):
-        centre = LEFT + slot * (i + 0.5)
+        centre = LEFT + frame.slot * (i + 0.5)
         out.append(
             f'<text x="{centre:.1f}" y="{HEIGHT - BOTTOM + 18}" text-anchor="middle">{ks:g}</text>'
         )
@@ -96,29 +117,33 @@ def svg(ladders):
             if not values:
                 continue
             mean = sum(values) / len(values)
-            x = centre - bar * len(ladders) / 2 + bar * n
+            x = centre - width * len(ladders) / 2 + width * n
             out.append(
-                f'<rect x="{x + 1:.1f}" y="{y(mean):.1f}" width="{bar - 2:.1f}" '
-                f'height="{y(0) - y(mean):.1f}" fill="{COLOURS[n]}"/>'
+                f'<rect x="{x + 1:.1f}" y="{frame.y(mean):.1f}" width="{width - 2:.1f}" '
+                f'height="{frame.y(0) - frame.y(mean):.1f}" fill="{COLOURS[n]}"/>'
             )
-            mid = x + bar / 2
+            mid = x + width / 2
             out.append(
-                f'<line x1="{mid:.1f}" x2="{mid:.1f}" y1="{y(min(values)):.1f}" '
-                f'y2="{y(max(values)):.1f}" stroke="black"/>'
+                f'<line x1="{mid:.1f}" x2="{mid:.1f}" y1="{frame.y(min(values)):.1f}" '
+                f'y2="{frame.y(max(values)):.1f}" stroke="black"/>'
             )
-    out.append(
-        f'<line x1="{LEFT}" x2="{LEFT}" y1="{TOP}" y2="{y(0):.1f}" stroke="black"/>'
-        f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{y(0):.1f}" y2="{y(0):.1f}" stroke="black"/>'
-    )
-    out.append(
-        f'<text x="{LEFT + plot_w / 2}" y="{HEIGHT - 18}" text-anchor="middle">ks / d50</text>'
-        f'<text transform="translate(18 {TOP + plot_h / 2}) rotate(-90)" '
-        'text-anchor="middle">eroded mass, kg/m (Eq. 34)</text>'
-    )
+    return out
+
+
+def labels(frame, ks_values, ladders):
+    """The axes, their titles and the legend."""
+    y0 = frame.y(0)
+    out = [
+        f'<line x1="{LEFT}" x2="{LEFT}" y1="{TOP}" y2="{y0:.1f}" stroke="black"/>'
+        f'<line x1="{LEFT}" x2="{WIDTH - RIGHT}" y1="{y0:.1f}" y2="{y0:.1f}" stroke="black"/>',
+        f'<text x="{LEFT + frame.plot_w / 2}" y="{HEIGHT - 18}" text-anchor="middle">ks / d50</text>'
+        f'<text transform="translate(18 {TOP + frame.plot_h / 2}) rotate(-90)" '
+        'text-anchor="middle">eroded mass, kg/m (Eq. 34)</text>',
+    ]
     legend = [(label, COLOURS[n]) for n, (label, _) in enumerate(ladders)]
     legend.append(("the aim at ks/d50 = 3: 0.5-3 kg/m", "#cfe8cf"))
     # Right of the band at ks/d50 = 3 and under the axis' top, where the bars stay low.
-    lx = LEFT + slot * min(3, len(ks_values) - 1) + 10
+    lx = LEFT + frame.slot * min(3, len(ks_values) - 1) + 10
     for n, (label, colour) in enumerate(legend):
         ly = TOP + 24 + 16 * n
         out.append(
@@ -126,11 +151,10 @@ def svg(ladders):
             f'<text x="{lx + 18:.1f}" y="{ly}">{escape(label)}</text>'
         )
     out.append(
-        f'<text x="{WIDTH - RIGHT - 4}" y="{y(PAPER_AXIS_KG_PER_M) - 4:.1f}" text-anchor="end" '
-        'fill="#555">top of the paper\'s axis</text>'
+        f'<text x="{WIDTH - RIGHT - 4}" y="{frame.y(PAPER_AXIS_KG_PER_M) - 4:.1f}" '
+        'text-anchor="end" fill="#555">top of the paper\'s axis</text>'
     )
-    out.append("</svg>")
-    return "\n".join(out) + "\n"
+    return out
 
 
 def escape(text):
