@@ -206,30 +206,25 @@ impl Pass<'_> {
     fn group(&self, group: &Group) -> (PairSum<Lanes>, [Lanes; 3]) {
         let (grid, model, sides) = (self.grid, self.model, self.sides);
         let side = Side::lanes(&sides[group.range.clone()]);
-        let reach = grid.reach();
         let mut sum = PairSum::<Lanes>::default();
         let mut tau = [Lanes::splat(0.0); 3];
         let stress = self.extra.stress.map(|(div, stress, _)| {
             let mine = StressSide::lanes(&stress[group.range.clone()]);
             (div, stress, mine)
         });
-        grid.row_span(
-            group.cell,
-            group.last_x(),
+        grid.group_cells(
+            group,
             #[inline(always)]
-            |range, x| {
-                let near = group.near(x, reach);
-                match &stress {
-                    None => {
-                        for j in range {
-                            model.add_pair(&side, &sides[j], near, &mut sum);
-                        }
+            |range, near| match &stress {
+                None => {
+                    for j in range {
+                        model.add_pair(&side, &sides[j], near, &mut sum);
                     }
-                    Some((div, stress, stress_i)) => {
-                        for j in range {
-                            if let Some(g) = model.add_pair(&side, &sides[j], near, &mut sum) {
-                                div.add_term(stress_i, &stress[j], &g, &mut tau);
-                            }
+                }
+                Some((div, stress, stress_i)) => {
+                    for j in range {
+                        if let Some(g) = model.add_pair(&side, &sides[j], near, &mut sum) {
+                            div.add_term(stress_i, &stress[j], &g, &mut tau);
                         }
                     }
                 }

@@ -206,9 +206,18 @@ impl Grid {
         }
     }
 
-    /// Cells each way the kernel support reaches.
-    pub fn reach(&self) -> i32 {
-        self.reach
+    /// Calls `visit` with the sorted-index range of each cell [`Grid::row_span`] gives for
+    /// `group`, and the lanes of the group within reach of it: the walk of both lane passes.
+    /// Like the `visit` a caller hands it, `#[inline(always)]` (`super::simd`).
+    #[inline(always)]
+    pub fn group_cells(&self, group: &Group, mut visit: impl FnMut(Range<usize>, LaneMask)) {
+        let reach = self.reach;
+        self.row_span(
+            group.cell,
+            group.last_x(),
+            #[inline(always)]
+            |range, x| visit(range, group.near(x, reach)),
+        );
     }
 
     /// Whether any particle that `flagged` counts lies in the cells within reach of `x`'s:

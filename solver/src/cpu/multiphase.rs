@@ -216,13 +216,10 @@ impl Pairs<'_> {
         });
         let mut sums = RheologySums::lanes(&starts);
         let side = RheologySide::lanes(&self.sides[range]);
-        let reach = grid.reach();
-        grid.row_span(
-            group.cell,
-            group.last_x(),
+        grid.group_cells(
+            group,
             #[inline(always)]
-            |range, x| {
-                let near = group.near(x, reach);
+            |range, near| {
                 for j in range {
                     pass.add_pair_of_volume(
                         &side,

@@ -5,9 +5,10 @@
 //! same to the bit on either. Only what LLVM inlines into [`avx2`] is in the AVX2 copy: a
 //! function it keeps apart is compiled once, for the baseline. So the closure handed to
 //! [`dispatch`] is `#[inline(always)]`, and so is the visitor a pass hands the cell list
-//! (`Grid::row_span`): until both were, the force pass's pair loops ran on four lanes (16 % of
-//! the CI flume's time in one function of SSE code). (A third copy for AVX-512F/VL, the same eight lanes with twice
-//! the registers, ran the CI flume 30 % slower here: it is not built.)
+//! (`Grid::group_cells`): until both were, the force pass's pair loops ran on four lanes (16 %
+//! of the CI flume's time in one function of SSE code). (A third copy for AVX-512F/VL, the
+//! same eight lanes with twice the registers, ran the CI flume 30 % slower here: it is not
+//! built.)
 
 /// Runs `f`, compiled for AVX2 where the CPU has it.
 #[inline(always)]
