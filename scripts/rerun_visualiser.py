@@ -5,6 +5,7 @@ paper's region, on a `sim_time` timeline.
 Usage:
   python3 scripts/rerun_visualiser.py [--service flume_twin/particles]
                                       [--save FILE.rrd | --connect URL | --spawn] [--frames N]
+                                      [--timeout S]
 Without --save/--connect it spawns a rerun viewer. Needs `pip install rerun-sdk iceoryx2`.
 The frame layout is node/src/adapters/frames.rs's (version 1), 32 bytes a particle.
 """
@@ -85,6 +86,12 @@ def main():
     sink.add_argument("--connect", metavar="URL")
     sink.add_argument("--spawn", action="store_true")
     parser.add_argument("--frames", type=int, default=0, help="stop after N frames (0: never)")
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=0.0,
+        help="exit with an error after S seconds without a frame (0: wait for the twin forever)",
+    )
     args = parser.parse_args()
 
     rr.init("flume_twin")
@@ -98,6 +105,11 @@ def main():
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
     node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
     name = iox2.ServiceName.new(args.service)
+    last_frame = time.monotonic()
+
+    def waited_too_long():
+        return args.timeout > 0 and time.monotonic() - last_frame > args.timeout
+
     while True:
         try:
             pubsub = (
@@ -109,6 +121,8 @@ def main():
             event = node.service_builder(name).event().open()
             break
         except Exception:  # the twin is not up yet
+            if waited_too_long():
+                sys.exit(f"no twin offered {args.service} within {args.timeout:g} s")
             time.sleep(0.5)
     subscriber = pubsub.subscriber_builder().create()
     listener = event.listener_builder().create()
@@ -117,7 +131,10 @@ def main():
         listener.timed_wait(iox2.Duration.from_millis(500))
         sample = subscriber.receive()
         if sample is None:
+            if waited_too_long():
+                sys.exit(f"no frame on {args.service} for {args.timeout:g} s; {shown} shown")
             continue
+        last_frame = time.monotonic()
         header = sample.user_header().contents
         if header.version != 1:
             sys.exit(f"frame layout version {header.version}; this visualiser reads version 1")

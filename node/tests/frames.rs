@@ -16,12 +16,14 @@ use std::process::{Child, Command, Stdio};
 /// The ULBRA flume at CI size: 4,582 particles.
 const PARTICLES: u64 = 4582;
 
-fn twin(service: &str, until: &str) -> Child {
+/// A twin that runs far past the test's end (it is killed or stopped), so that no reader can
+/// come after its twin has finished.
+fn twin(service: &str) -> Child {
     ulbra_twin()
         .args([
             "--no-replay",
             "--until",
-            until,
+            "600",
             "--frames-service",
             service,
             "--frames-rate-hz",
@@ -117,7 +119,7 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
     let service = format!("flume_twin/test_{}", std::process::id());
 
     // A twin killed while running leaves its shared memory behind.
-    let mut crashed = twin(&service, "5");
+    let mut crashed = twin(&service);
     let first = frames_of(reader(&service, 1, false));
     assert_eq!(first.len(), 1);
     crashed.kill().expect("kill -9");
@@ -125,7 +127,7 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
 
     // The next twin cleans up and offers the service again; a reader holds a frame and is
     // killed; the twin runs on to its end and a new reader gets frames.
-    let running = twin(&service, "1.0");
+    let running = twin(&service);
     let mut stuck = reader(&service, 1, true);
     let mut lines = BufReader::new(stuck.stdout.take().expect("stdout")).lines();
     let frame = lines.next().expect("a frame").expect("a line");
@@ -138,7 +140,15 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
     let rrd = std::env::temp_dir().join(format!("flume-frames-{}.rrd", std::process::id()));
     let visualiser = Command::new("python3")
         .arg(repo_file("scripts/rerun_visualiser.py"))
-        .args(["--service", &service, "--frames", "2", "--save"])
+        .args([
+            "--service",
+            &service,
+            "--frames",
+            "2",
+            "--timeout",
+            "120",
+            "--save",
+        ])
         .arg(&rrd)
         .status()
         .expect("runs the visualiser");
@@ -166,8 +176,15 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
         "a frame per row"
     );
     std::fs::remove_file(&rrd).ok();
+    // SIGTERM, as a launch system stops the node: it ends cleanly, with its last frame sent
+    // while a killed reader still holds one.
+    let term = Command::new("kill")
+        .args(["-TERM", &running.id().to_string()])
+        .status()
+        .expect("runs kill");
+    assert!(term.success());
     let log = ends_well(running);
-    assert!(log.contains("reached t = 1.000 s"), "{log}");
+    assert!(log.contains("terminated at t = "), "{log}");
     assert!(log.contains("particle frames: iceoryx2 service"), "{log}");
     assert!(
         log.contains("dead iceoryx2 node(s) left in shared memory"),
@@ -203,4 +220,36 @@ fn the_frame_benchmark_reads_whole_frames_at_the_paper_s_count() {
         .parse()
         .expect("a mean density");
     assert!((1000.0..=2650.0).contains(&density), "{line}");
+}
+
+/// A visualiser asked for frames that never come says so and exits, rather than waiting
+/// for ever (a batch job or a test would otherwise hang on a twin that has ended).
+#[test]
+fn the_visualiser_gives_up_on_a_service_no_twin_offers() {
+    if !python_has("iceoryx2, rerun", "iceoryx2 rerun-sdk") {
+        return;
+    }
+    let rrd = std::env::temp_dir().join(format!("flume-no-twin-{}.rrd", std::process::id()));
+    let service = format!("flume_twin/nobody_{}", std::process::id());
+    let out = Command::new("python3")
+        .arg(repo_file("scripts/rerun_visualiser.py"))
+        .args([
+            "--service",
+            &service,
+            "--frames",
+            "1",
+            "--timeout",
+            "2",
+            "--save",
+        ])
+        .arg(&rrd)
+        .output()
+        .expect("runs the visualiser");
+    std::fs::remove_file(&rrd).ok();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("no twin offered {service} within 2 s")),
+        "{err}"
+    );
 }
