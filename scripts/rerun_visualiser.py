@@ -126,6 +126,7 @@ def main():
             time.sleep(0.5)
     subscriber = pubsub.subscriber_builder().create()
     listener = event.listener_builder().create()
+    print(f"reading particle frames from {args.service}", flush=True)
     shown = 0
     while args.frames == 0 or shown < args.frames:
         listener.timed_wait(iox2.Duration.from_millis(500))

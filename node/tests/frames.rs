@@ -2,15 +2,18 @@
 //! (`tests/interop/iox2_frames.py`): every particle of the flume in each frame, with the
 //! header's version, count, phases and regions in range and finite values; a reader that
 //! holds a frame and is killed leaves the twin running and the next reader served; a twin
-//! killed with `kill -9` leaves shared memory that the next twin cleans up and reuses; and the
-//! reference visualiser (`scripts/rerun_visualiser.py`) writes frames that rerun's own reader
-//! reads back.
+//! killed with `kill -9` leaves shared memory that the next twin cleans up and reuses; a twin
+//! stopped with SIGTERM ends cleanly; and the reference visualiser
+//! (`scripts/rerun_visualiser.py`) writes frames that rerun's own reader reads back, and gives
+//! up with an error, instead of waiting for ever, on a service no twin offers or one whose twin
+//! has ended.
 
 mod common;
 
 use common::{gpu, printed, python_has, repo_file, ulbra_twin};
 use serde_json::Value;
 use std::io::{BufRead, BufReader};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
 /// The ULBRA flume at CI size: 4,582 particles.
@@ -103,6 +106,17 @@ fn frames_of(child: Child) -> Vec<Value> {
     frames
 }
 
+/// The reference visualiser on `service`, saving `frames` frames to `rrd` and giving up after
+/// `timeout_s` seconds without one.
+fn visualiser(service: &str, frames: &str, timeout_s: &str, rrd: &Path) -> Command {
+    let mut c = Command::new("python3");
+    c.arg(repo_file("scripts/rerun_visualiser.py"))
+        .args(["--service", service, "--frames", frames])
+        .args(["--timeout", timeout_s, "--save"])
+        .arg(rrd);
+    c
+}
+
 fn ends_well(twin: Child) -> String {
     let out = twin.wait_with_output().expect("the twin ends");
     let log = printed(&out);
@@ -124,6 +138,7 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
     assert_eq!(first.len(), 1);
     crashed.kill().expect("kill -9");
     crashed.wait().expect("reaped");
+    let rrd = std::env::temp_dir().join(format!("flume-frames-{}.rrd", std::process::id()));
 
     // The next twin cleans up and offers the service again; a reader holds a frame and is
     // killed; the twin runs on to its end and a new reader gets frames.
@@ -137,22 +152,10 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
     stuck.wait().expect("reaped");
     let later = frames_of(reader(&service, 3, false));
     assert_eq!(later.len(), 3);
-    let rrd = std::env::temp_dir().join(format!("flume-frames-{}.rrd", std::process::id()));
-    let visualiser = Command::new("python3")
-        .arg(repo_file("scripts/rerun_visualiser.py"))
-        .args([
-            "--service",
-            &service,
-            "--frames",
-            "2",
-            "--timeout",
-            "120",
-            "--save",
-        ])
-        .arg(&rrd)
+    let saved = visualiser(&service, "2", "120", &rrd)
         .status()
         .expect("runs the visualiser");
-    assert!(visualiser.success());
+    assert!(saved.success());
     let read_back = Command::new("python3")
         .args([
             "-c",
@@ -175,15 +178,42 @@ fn python_reads_every_particle_and_dead_readers_or_twins_stall_nothing() {
         "2 2",
         "a frame per row"
     );
-    std::fs::remove_file(&rrd).ok();
-    // SIGTERM, as a launch system stops the node: it ends cleanly, with its last frame sent
-    // while a killed reader still holds one.
+    // A visualiser that reads on while the twin is stopped: SIGTERM, as a launch system
+    // stops the node, ends the twin cleanly (its last frame sent while a killed reader still
+    // holds one), and the visualiser, its frames over, gives up instead of waiting for ever
+    // (the wait that once hung this test on a twin that had ended).
+    let mut watching = visualiser(&service, "1000000", "3", &rrd);
+    let mut watching = watching
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("starts the visualiser");
+    let mut said = BufReader::new(watching.stdout.take().expect("stdout")).lines();
+    let first = said.next().expect("a line").expect("utf-8");
+    assert_eq!(first, format!("reading particle frames from {service}"));
     let term = Command::new("kill")
         .args(["-TERM", &running.id().to_string()])
         .status()
         .expect("runs kill");
     assert!(term.success());
     let log = ends_well(running);
+    // Polled, so that a visualiser that waits for ever fails the test instead of hanging it.
+    let started = std::time::Instant::now();
+    while watching.try_wait().expect("polls the visualiser").is_none() {
+        if started.elapsed().as_secs() > 60 {
+            watching.kill().ok();
+            panic!("the visualiser still waits 60 s after the twin ended");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let out = watching.wait_with_output().expect("the visualiser ends");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("no frame on {service} for 3 s")),
+        "{err}"
+    );
+    std::fs::remove_file(&rrd).ok();
     assert!(log.contains("terminated at t = "), "{log}");
     assert!(log.contains("particle frames: iceoryx2 service"), "{log}");
     assert!(
@@ -231,18 +261,7 @@ fn the_visualiser_gives_up_on_a_service_no_twin_offers() {
     }
     let rrd = std::env::temp_dir().join(format!("flume-no-twin-{}.rrd", std::process::id()));
     let service = format!("flume_twin/nobody_{}", std::process::id());
-    let out = Command::new("python3")
-        .arg(repo_file("scripts/rerun_visualiser.py"))
-        .args([
-            "--service",
-            &service,
-            "--frames",
-            "1",
-            "--timeout",
-            "2",
-            "--save",
-        ])
-        .arg(&rrd)
+    let out = visualiser(&service, "1", "2", &rrd)
         .output()
         .expect("runs the visualiser");
     std::fs::remove_file(&rrd).ok();
