@@ -60,17 +60,24 @@ pub fn rheology_pass(
     let held_before = holds.before;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = held_before.len();
-    let (vol, sides): (Vec<f32>, Vec<RheologySide>) = pool.install(|| {
+    let stirring = holds
+        .awake_set
+        .then(|| stirring(params, (pos, vel), held_before));
+    // One parallel region, not two: a region costs a step more than its work at CI size
+    // (README, speed).
+    let (vol, (sides, asleep)): (Vec<f32>, (Vec<RheologySide>, Vec<bool>)) = pool.install(|| {
         (0..n)
             .into_par_iter()
-            .map(|i| (pass.volume(&pos[i], &vel[i]), pass.side(&pos[i], &vel[i])))
+            .map(|i| {
+                let side = pass.side(&pos[i], &vel[i]);
+                let sleeps = held_before[i]
+                    && stirring
+                        .as_ref()
+                        .is_some_and(|s| !grid.any_near(s, &side.x));
+                (pass.volume(&pos[i], &vel[i]), (side, sleeps))
+            })
             .unzip()
     });
-    let asleep = if holds.awake_set {
-        sleepers(pool, params, grid, (pos, vel), held_before, &sides)
-    } else {
-        vec![false; n]
-    };
     let pairs = Pairs {
         params,
         pass: &pass,
@@ -102,53 +109,56 @@ pub fn rheology_pass(
             .sum()
     });
     if release {
-        let stage = Release::new(params, model);
-        let released: Vec<bool> = pool.install(|| {
-            (0..out.len())
-                .into_par_iter()
-                .map(|i| {
-                    if !stage.applies(&pos[i], &out[i]) {
-                        return false;
-                    }
-                    let mut sums = Transmitted::default();
-                    grid.rows(grid.coords(&[pos[i][0], pos[i][1], pos[i][2]]), |range| {
-                        for j in range {
-                            stage.add_pair(&pos[i], (&pos[j], &vel[j], &out[j]), &mut sums);
-                        }
-                    });
-                    stage.released(vel[i][3], &sums)
-                })
-                .collect()
-        });
-        for (r, _) in out.iter_mut().zip(released).filter(|(_, go)| *go) {
-            r.held = false;
-            r.region = Region::Yielded as u32;
-        }
+        release_held(pool, (params, model), grid, (pos, vel), &mut out);
     }
     RheologyPass { out, asleep }
 }
 
-/// The grains that may sleep (see the module doc): held before, with nothing but held grains
-/// and walls at rest in the cells within reach.
-fn sleepers(
+/// Releases the held sediment whose neighbours transmit enough stress (`hold.wgsl`), from the
+/// regions `out` the rheology pass left, before any release.
+fn release_held(
     pool: &rayon::ThreadPool,
-    params: &Params,
+    (params, model): (&Params, &SedimentModel),
     grid: &Grid,
     (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+    out: &mut [ParticleRheology],
+) {
+    let stage = Release::new(params, model);
+    let released: Vec<bool> = pool.install(|| {
+        (0..out.len())
+            .into_par_iter()
+            .map(|i| {
+                if !stage.applies(&pos[i], &out[i]) {
+                    return false;
+                }
+                let mut sums = Transmitted::default();
+                grid.rows(grid.coords(&[pos[i][0], pos[i][1], pos[i][2]]), |range| {
+                    for j in range {
+                        stage.add_pair(&pos[i], (&pos[j], &vel[j], &out[j]), &mut sums);
+                    }
+                });
+                stage.released(vel[i][3], &sums)
+            })
+            .collect()
+    });
+    for (r, _) in out.iter_mut().zip(released).filter(|(_, go)| *go) {
+        r.held = false;
+        r.region = Region::Yielded as u32;
+    }
+}
+
+/// The particles that stir a held grain's neighbourhood: any but held grains and walls at
+/// rest. A held grain with none of them in the cells within reach sleeps (see the module doc).
+fn stirring(
+    params: &Params,
+    (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
     held_before: &[bool],
-    sides: &[RheologySide],
-) -> Vec<bool> {
+) -> Flagged {
     let rests = |k: usize| {
         let still = vel[k][..3].iter().all(|&v| v == 0.0);
         still && (held_before[k] || !params.phases[phase_index(&pos[k])].mobile)
     };
-    let stirring = Flagged::new(held_before.len(), |k| !rests(k));
-    pool.install(|| {
-        (0..held_before.len())
-            .into_par_iter()
-            .map(|i| held_before[i] && !grid.any_near(&stirring, &sides[i].x))
-            .collect()
-    })
+    Flagged::new(held_before.len(), |k| !rests(k))
 }
 
 /// Particles per block handed to a thread, as in the force pass.

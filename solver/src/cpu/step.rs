@@ -59,34 +59,38 @@ impl CpuEngine {
         let store = Store::new(&self.params, &self.model);
         let bed_walls = self.bed_is_boundary();
         let shields_only = self.params.sediment.shields_only != 0;
-        let (sides, imposed): (Vec<Side>, Vec<bool>) = self.pool.install(|| {
-            (0..active)
-                .into_par_iter()
-                .map(|i| {
-                    let imposed = store.velocity_imposed(&pos[i]);
-                    let side = model.side(&pos[i], &vel[i]);
-                    // The Shields-only mode's held bed stands as a wall does
-                    // (`physics::boundary`), or is fixed where it stands.
-                    let held = rheology.as_ref().is_some_and(|r| r[i].held);
-                    let side = Side {
-                        imposed,
-                        mobile: side.mobile && !(bed_walls && held),
-                        fixed: side.mobile && held && !bed_walls && shields_only,
-                        ..side
-                    };
-                    (side, imposed)
-                })
-                .unzip()
-        });
         let div = StressDivergence::new(&self.model);
-        let stress: Option<(Vec<StressSide>, Vec<f32>)> = rheology.map(|r| {
-            self.pool.install(|| {
-                (0..active)
-                    .into_par_iter()
-                    .map(|i| (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu))
-                    .unzip()
-            })
-        });
+        let side_of = |i: usize| {
+            let imposed = store.velocity_imposed(&pos[i]);
+            let side = model.side(&pos[i], &vel[i]);
+            // The Shields-only mode's held bed stands as a wall does (`physics::boundary`), or
+            // is fixed where it stands.
+            let held = rheology.as_ref().is_some_and(|r| r[i].held);
+            let side = Side {
+                imposed,
+                mobile: side.mobile && !(bed_walls && held),
+                fixed: side.mobile && held && !bed_walls && shields_only,
+                ..side
+            };
+            (side, imposed)
+        };
+        type Stress = (Vec<StressSide>, Vec<f32>);
+        // The stress sides in the same parallel region as the pair sides: a region costs a
+        // step more than its work at CI size (README, speed).
+        let ((sides, imposed), stress): ((Vec<Side>, Vec<bool>), Option<Stress>) =
+            self.pool.install(|| match &rheology {
+                None => ((0..active).into_par_iter().map(side_of).unzip(), None),
+                Some(r) => {
+                    let (sides, stress) = (0..active)
+                        .into_par_iter()
+                        .map(|i| {
+                            let stress = (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu);
+                            (side_of(i), stress)
+                        })
+                        .unzip();
+                    (sides, Some(stress))
+                }
+            });
         let mobile = self
             .awake_set
             .then(|| Flagged::new(active, |k| sides[k].mobile));
