@@ -15,8 +15,15 @@ fn in_duct(x: vec3<f32>) -> bool {
     return f.enabled != 0u && x.x >= f.duct_x_min && x.y > f.duct_y_min && x.y <= f.duct_y_max;
 }
 
-// Whether water particle at `x` moves at an imposed velocity: such a particle may be
-// squeezed against its neighbours without moving apart, so its acceleration means nothing.
+// Whether the inlet carries a particle of `phase` at `x` out at its velocity: water, or
+// sediment, in its buffer (no grain rests in an orifice's jet; `Store::carried_by_inlet`).
+fn carried_by_inlet(x: vec3<f32>, phase: u32) -> bool {
+    let sediment = params.sediment.phase != 0u && phase == params.sediment.phase;
+    return (phase == params.flume.water_phase || sediment) && in_inlet(x);
+}
+
+// Whether a particle at `x` moves at an imposed velocity: such a particle may be squeezed
+// against its neighbours without moving apart, so its acceleration means nothing.
 fn velocity_imposed(x: vec3<f32>, phase: u32) -> bool {
-    return phase == params.flume.water_phase && (in_inlet(x) || in_duct(x));
+    return carried_by_inlet(x, phase) || (phase == params.flume.water_phase && in_duct(x));
 }

@@ -62,11 +62,11 @@ fn parked(id: u32, fate: u32) -> Stored {
 // tension (clamp_pressure) its density stays at or above rest as a free particle's does: a
 // held bed under sand sliding off it would otherwise thin out without end. In an open flume
 // (whose parked particles never get here: the integrators run over the active ones only):
-// fluid past the outlet and sediment in the collector are parked; the inlet buffer moves at
-// the inlet velocity, at its density; water in a bottom outlet's duct moves at the valve's
-// velocity; a free particle whose density leaves the range is excluded (a lone splash meeting
-// a wall compresses by about its Mach number v / c0: that is one particle's fate, not a
-// blow-up of the run).
+// fluid past the outlet and sediment in the collector are parked; the inlet buffer (water,
+// or sediment that strayed into it) moves at the inlet velocity, at its density; water in a
+// bottom outlet's duct moves at the valve's velocity; a free particle whose density leaves the
+// range is excluded (a lone splash meeting a wall compresses by about its Mach number v / c0:
+// that is one particle's fate, not a blow-up of the run).
 fn store_rule(id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, rho: f32, held: bool, dt: f32) -> Stored {
     let phase = bitcast<u32>(p.w);
     let ph = params.phases[phase];
@@ -83,7 +83,7 @@ fn store_rule(id: u32, p: vec4<f32>, vr: vec4<f32>, x: vec3<f32>, v: vec3<f32>, 
         if (sediment && x.x >= f.collector_x_min && x.x <= f.collector_x_max && x.y < f.collector_y_max) {
             return parked(id, STORED_ERODED);
         }
-        if (phase == f.water_phase && in_inlet(p.xyz)) {
+        if (carried_by_inlet(p.xyz, phase)) {
             // Imposed velocity, and the density it entered with: a buffer column drawing away
             // from the wall behind it would otherwise thin out until the next one enters.
             let u = vec3<f32>(f.inlet_u, 0.0, 0.0);

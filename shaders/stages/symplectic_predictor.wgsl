@@ -31,7 +31,7 @@ fn symplectic_predictor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let f = forces[i];
     let phase = bitcast<u32>(p.w);
     let rho = vr.w + half_dt * f.w;
-    if (phase == params.flume.water_phase && in_inlet(p.xyz)) {
+    if (carried_by_inlet(p.xyz, phase)) {
         // The inlet buffer moves at the inlet velocity, at its density (store_rule.wgsl).
         let u = vec3<f32>(params.flume.inlet_u, 0.0, 0.0);
         textureStore(positions_half, texel(i), vec4<f32>(p.xyz + half_dt * u, p.w));
