@@ -60,7 +60,7 @@ pub fn rheology_pass(
     let held_before = holds.before;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = held_before.len();
-    let stirring = holds
+    let stirrers = holds
         .awake_set
         .then(|| stirring(params, (pos, vel), held_before));
     // One parallel region, not two: a region costs a step more than its work at CI size
@@ -71,7 +71,7 @@ pub fn rheology_pass(
             .map(|i| {
                 let side = pass.side(&pos[i], &vel[i]);
                 let sleeps = held_before[i]
-                    && stirring
+                    && stirrers
                         .as_ref()
                         .is_some_and(|s| !grid.any_near(s, &side.x));
                 (pass.volume(&pos[i], &vel[i]), (side, sleeps))
