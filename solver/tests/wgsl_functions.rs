@@ -11,14 +11,15 @@
 //! Each probe (`common/probe.rs`) composes the shared modules the function needs, binds the case's uniform block
 //! as the stages do, and writes one `vec4<f32>` per input. Both sides compute in f32; they
 //! agree within 2e-6 relatively (measured on lavapipe: at most 5e-7, a few ulp of `log`, `exp`
-//! and `pow`), and exactly for regions; where a value falls to zero (the kernel at its support's
+//! and `pow`), and exactly for regions; the equation of state and the Drucker-Prager yield
+//! stress also allow the 2.5 ulp that Vulkan lets a division be off (an H100's driver uses it); where a value falls to zero (the kernel at its support's
 //! edge) or loses its digits to a cancellation (the slope factors) the test says how much
 //! more it allows.
 
 mod common;
 
 use common::gpu_lock;
-use common::probe::{Input, probe, same};
+use common::probe::{Input, VULKAN_DIVISION, probe, same};
 use flume_solver::Region;
 use flume_solver::physics::eos;
 use flume_solver::physics::eos::pressure;
@@ -32,6 +33,14 @@ use flume_solver::physics::sediment::suspension::{
     RegionInputs, apparent_viscosity, sediment_region, vand_viscosity,
 };
 use flume_solver::physics::timestep::{NextStep, next_step, particle_viscous_bound, stable_step};
+
+/// What the Tait pressure `B ((rho / rho0)^7 - 1)` may differ by, Pa, up to `rho / rho0 = x_max`,
+/// where the adapter divides as loosely as Vulkan allows: the seventh power makes the
+/// quotient's relative error seven times larger (on an H100, 3.9e-7 B was seen at rho / rho0 =
+/// 0.985; this allows 4.1e-6 B at 1.1).
+fn tait_division_slack(b: f32, x_max: f32) -> f32 {
+    7.0 * VULKAN_DIVISION * b * x_max.powi(7)
+}
 
 /// `n` values from `lo` to `hi`, evenly spaced in their logarithm.
 fn log_grid(lo: f32, hi: f32, n: usize) -> Vec<f32> {
@@ -73,11 +82,12 @@ fn kernel_and_equation_of_state() {
         let densities: Vec<Input> = (0..=40)
             .map(|k| one(ph.rho0 * (0.9 + 0.005 * k as f32)))
             .collect();
-        p.agree(
+        p.agree_within(
             &format!("Tait pressure of phase {phase}"),
             &format!("vec4<f32>(tait_pressure(a.x, {phase}u), 0.0, 0.0, 0.0)"),
             &densities,
             1,
+            tait_division_slack(b, 1.1),
             |i| [pressure(i[0][0], ph.rho0, b), 0.0, 0.0, 0.0],
         );
     }
@@ -181,11 +191,12 @@ fn the_sediment_laws() {
     let densities: Vec<Input> = (0..=40)
         .map(|k| one(sed.rho0 * (0.95 + 0.0025 * k as f32)))
         .collect();
-    p.agree(
+    p.agree_within(
         "Drucker-Prager yield stress",
         "vec4<f32>(drucker_prager_yield(a.x), 0.0, 0.0, 0.0)",
         &densities,
         1,
+        alpha(mat.phi_rad) * skeleton_pressure(tait_division_slack(b, 1.05), mat.rho_s, mat.rho_w),
         |i| {
             let p_skel = skeleton_pressure(pressure(i[0][0], sed.rho0, b), mat.rho_s, mat.rho_w);
             let tau_y = yield_stress(

@@ -170,6 +170,11 @@ fn probe(@builtin(global_invocation_id) gid: vec3<u32>) {{
     }
 }
 
+/// The most a Vulkan implementation's f32 division may be off, relatively: 2.5 ulp for a divisor
+/// of normal size (Vulkan specification, appendix A, precision of `OpFDiv`), an ulp being at most
+/// 2^-23 of the value. lavapipe divides exactly; NVIDIA's driver (580) does not.
+pub const VULKAN_DIVISION: f32 = 2.5 * f32::EPSILON;
+
 /// Within 2e-6 relatively (16 ulp) and `abs` absolutely; the WGSL's HUGE stands for
 /// infinity.
 pub fn same(gpu: f32, rust: f32, abs: f32) -> bool {
