@@ -40,6 +40,16 @@ pub struct FlumeState {
     pub excluded_sediment: u64,
 }
 
+/// Share of the inflow's particles left unplaced, 0-1: `blocked` spots against `placed` ones.
+pub fn blocked_share(blocked: u64, placed: u64) -> f64 {
+    let due = blocked + placed;
+    if due == 0 {
+        0.0
+    } else {
+        blocked as f64 / due as f64
+    }
+}
+
 /// What the inlet needs this time: new columns, each at its x, m.
 pub struct Injection {
     pub columns_x_m: Vec<f64>,

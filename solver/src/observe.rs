@@ -66,10 +66,22 @@ pub struct FlumeObservation {
     pub parked_particles: u64,
     /// Inlet particles not placed for want of parked ones, since the start.
     pub starved_particles: u64,
+    /// Inlet spots left empty since the start because a particle sat within dp / 2 of them,
+    /// and the particles the inlet has placed: the inflow falls short by the ratio of the
+    /// first to their sum.
+    pub blocked_particles: u64,
+    pub injected_particles: u64,
     /// Particles excluded for a density out of range since the start (recycled through the
     /// inlet; `crate::health`), and how many of them were sediment.
     pub excluded_particles: u64,
     pub excluded_sediment: u64,
+}
+
+impl FlumeObservation {
+    /// Share of the inflow's particles that the inlet could not place since the start, 0-1.
+    pub fn blocked_share(&self) -> f64 {
+        crate::flume::blocked_share(self.blocked_particles, self.injected_particles)
+    }
 }
 
 /// The top of each fluid phase's layer and the free surface along one vertical line.

@@ -259,6 +259,15 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
                 f.excluded_particles, f.excluded_sediment
             ),
         ]);
+        t.row([
+            "inlet spots blocked".to_string(),
+            format!(
+                "{} of {} ({:.2} % of the inflow not placed)",
+                f.blocked_particles,
+                f.blocked_particles + f.injected_particles,
+                100.0 * f.blocked_share()
+            ),
+        ]);
     }
     t.row([
         "blow-ups recovered".to_string(),

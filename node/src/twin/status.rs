@@ -165,6 +165,10 @@ impl Twin {
                 "excluded_particles",
                 flume.map_or(0, |f| f.excluded_particles).to_string(),
             ),
+            (
+                "inlet_blocked_spots",
+                flume.map_or(0, |f| f.blocked_particles).to_string(),
+            ),
             ("particle_frames_sent", c.frames_sent.to_string()),
             ("particle_frames_skipped", c.frames_skipped.to_string()),
         ];

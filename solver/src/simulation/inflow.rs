@@ -5,7 +5,7 @@ use super::Simulation;
 use crate::derived::{MAX_INLET_MACH, max_inflow_m3_per_s};
 use crate::error::SolverError;
 use crate::flume::BoundaryConditions;
-use crate::flume::inlet_velocity;
+use crate::flume::{blocked_share, inlet_velocity};
 
 /// Discharges to apply on the way to a time: `(time s, discharge m3/s)` in time order, each
 /// in force from its own time on (one stamped before the simulation's time applies at once).
@@ -62,6 +62,7 @@ impl Simulation {
         let mut free = scan.parked_slots.into_iter();
         let mut starved = 0u64;
         let mut placed = 0u64;
+        let blocked_before = f.blocked_particles;
         for (spot, occupied) in spots.iter().zip(scan.occupied) {
             if occupied {
                 f.blocked_particles += 1;
@@ -77,6 +78,20 @@ impl Simulation {
         }
         f.parked_particles = f.parked_particles.saturating_sub(placed);
         f.injected_particles += placed;
+        let doubled = match blocked_before.checked_ilog2() {
+            None => f.blocked_particles > 0,
+            Some(b) => f.blocked_particles.ilog2() > b,
+        };
+        if doubled {
+            // At each doubling: a bed that keeps the buffer busy is told of a few times, not at
+            // every column.
+            log::warn!(
+                "t = {:.3} s: {} inlet spots left empty since the start, a particle sitting on each ({:.2} % of the inflow not placed)",
+                self.time_s,
+                f.blocked_particles,
+                100.0 * blocked_share(f.blocked_particles, f.injected_particles)
+            );
+        }
         if starved > 0 {
             f.starved_particles += starved;
             log::warn!(

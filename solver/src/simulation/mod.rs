@@ -590,6 +590,8 @@ impl Simulation {
                 eroded_rate_kg_per_s: rate,
                 parked_particles: f.parked_particles,
                 starved_particles: f.starved_particles,
+                blocked_particles: f.blocked_particles,
+                injected_particles: f.injected_particles,
                 excluded_particles: f.excluded_particles,
                 excluded_sediment: f.excluded_sediment,
             });
