@@ -165,6 +165,10 @@ fn slope_factors(n: vec3<f32>, u: vec3<f32>, phi: f32) -> f32 {
     if (speed_h == 0.0 || n_len == 0.0) {
         return 1.0;
     }
+    // A bed that faces down holds no grain (`slope_factors` in pass.rs).
+    if (n[v] < 0.0) {
+        return 0.0;
+    }
     var nh = n;
     nh[v] = 0.0;
     let n_s = dot(nh, uh) / speed_h;

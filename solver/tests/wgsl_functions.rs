@@ -131,10 +131,11 @@ fn the_shields_solve() {
     );
 
     // The bed's normal tilted up and down the flow and across it (a 2-D case: across is
-    // ignored), flows either way.
+    // ignored), and past the horizontal (the roof of a hole, which holds no grain), flows
+    // either way.
     let phi = p.model.material.phi_rad;
     let mut slopes = Vec::new();
-    for tilt in [-0.5f32, -0.2, 0.0, 0.1, 0.3, 0.52, 0.8] {
+    for tilt in [-2.5f32, -0.5, -0.2, 0.0, 0.1, 0.3, 0.52, 0.8, 1.6, 2.2] {
         for ux in [-0.4f32, 0.0, 0.25] {
             slopes.push([[tilt.sin(), tilt.cos(), 0.0, 0.0], [ux, 0.05, 0.0, phi]]);
         }

@@ -196,7 +196,11 @@ pub fn skeleton_pressure(p: f32, rho_s: f32, rho_w: f32) -> f32 {
 /// The slope is the normal's tilt: `tan(beta) = n_s / n_v` along the flow's horizontal direction
 /// s, `tan(gamma) = |n_t| / n_v` across it (3-D only). The flow runs down the slope when the
 /// normal leans the way the flow goes (`n_s > 0`). With no horizontal flow, or no normal, the
-/// bed counts as flat (factor 1); a normal pointing down (an overhang) gives beta >= 90 degrees.
+/// bed counts as flat (factor 1). A normal pointing down (the roof of a hole the jet dug) holds
+/// no grain, whichever way the water flows: gravity pulls the grain off such a bed, so no
+/// friction holds it (Eq. 22 assumes the grain rests on the bed; for up-slope flow it would
+/// still give a positive factor up to beta = 180 deg - phi). The transverse angle gave 0 there
+/// before this was said, in 2-D too (atan2(0, n_v < 0) = 180 deg); the outputs are the same.
 pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
     let v = (dim - 1) as usize;
     let horizontal = if dim == 2 { 1 } else { 2 };
@@ -204,6 +208,9 @@ pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
     let n_len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     if speed_h == 0.0 || n_len == 0.0 {
         return 1.0;
+    }
+    if n[v] < 0.0 {
+        return 0.0;
     }
     let mut n_s = 0.0;
     for k in 0..horizontal {

@@ -37,6 +37,24 @@ fn slope_factor_by_hand() {
     assert!((across - 0.937_755).abs() < 1e-5, "{across}");
 }
 
+#[test]
+fn a_bed_that_faces_down_holds_no_grain() {
+    // The roof of a hole, its normal 40 deg below the horizontal (beta = 130 deg): a flow
+    // towards -x runs up that slope, where Eq. 22 alone would give sin(160) / sin(30) = 0.684;
+    // towards +x down it, sin(-100) < 0. The grain hangs from the bed: no critical stress.
+    let n = [(40.0 * DEG).cos(), -(40.0 * DEG).sin(), 0.0];
+    for u in [[-0.2, 0.0, 0.0], [0.2, 0.0, 0.0]] {
+        assert_eq!(slope_factors(n, u, 2, 30.0 * DEG), 0.0, "{u:?}");
+    }
+    let n3 = [n[0], 0.0, n[1]];
+    assert_eq!(slope_factors(n3, [-0.2, 0.1, 0.0], 3, 30.0 * DEG), 0.0);
+    // Just above the horizontal, a wall of sand facing the flow still holds (beta = 89 deg:
+    // sin(119) / sin(30) = 1.749).
+    let wall = [(89.0 * DEG).sin(), (89.0 * DEG).cos(), 0.0];
+    let k = slope_factors(wall, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
+    assert!((k - 1.749_2).abs() < 1e-3, "{k}");
+}
+
 /// The case's sand (d50 0.4 mm, 2710 kg/m3, phi 32 deg) in the Shields-only mode, at
 /// dp = 1 cm with h = 1.7 dp: phases wall, water, sand.
 fn flume_case() -> (Params, SedimentModel) {
