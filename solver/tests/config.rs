@@ -263,8 +263,8 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
             "no row under its top",
         ),
         (
-            "  - phase: sand\n    min_m: [0.1, 0.0]",
-            "  - phase: water\n    min_m: [0.1, 0.0]",
+            "  - phase: sand\n    min_m: [0.0, 0.0]",
+            "  - phase: water\n    min_m: [0.0, 0.0]",
             "open_flume.sill",
             "ends a sediment bed",
         ),

@@ -1,7 +1,7 @@
 //! The erosion chain on the flowing flume, grain by grain, against an oracle written here from
 //! the paper's equations (`MODEL.md`, Eqs. 16-26) in f64: its own neighbour search (every pair),
-//! its own kernel, the friction velocity by bisection on the velocity profile (the code takes
-//! Newton steps in f32), and its own region of Figure 2 in the Shields-only mode.
+//! its own kernel, the friction velocity by a scan and bisection on the velocity profile (the
+//! code takes Newton steps in f32, piece by piece), and its own region of Figure 2 in the Shields-only mode.
 //!
 //! The CI-size ULBRA flume (dp = 1 cm, the case's DBC walls) at 5 s, while the front's wake
 //! moves the bed, and at 15 s, once it has filled. For every sand grain: whether it lies at the
@@ -21,9 +21,16 @@
 //! The slope of Eqs. 22-24 is the bed's: the normal out of the sand and walls around the grain
 //! (`pass.rs` says why not the water's), and a down-slope past the friction angle holds no grain.
 //!
-//! Measured (the test prints them): at 5 s, 214 grains at the surface, 194 of them over the
-//! threshold, Shields numbers 0.04-0.07 against about 0.04; at 15 s, 220 at the surface and 5
-//! over it, Shields 0.01-0.04 (tau_b / tau_bcr 0.3-1.0).
+//! Measured on the paper's bed (the test prints them): at 5 s, 129 grains at the surface (the
+//! front has wetted the bed to x = 1.3 m), 5 of them over the threshold, Shields numbers
+//! 0.02-0.03 against about 0.04; at 15 s, 246 at the surface and 11 over it, Shields 0.01-0.02
+//! (tau_b / tau_bcr 0.2-0.5). With the fixed apron the case had before 2026-11-27, the front
+//! had crossed the bed by 5 s: 214 at the surface, 194 over the threshold, Shields 0.04-0.07.
+//! The paper's bed brought two grains the oracle had not met: one under the roof of the hole
+//! the jet digs (a bed that faces down, where the code's factor was already 0, now said on both
+//! sides), and one whose profile passes its speed twice near Re_k = 5 (the code takes the
+//! smaller u*, as its documentation says; the oracle's bisection found the larger, and now
+//! scans up from the smallest).
 
 mod common;
 
@@ -121,10 +128,22 @@ impl Oracle {
         u_star / KARMAN * (z / z0).ln()
     }
 
-    /// The u* whose profile passes through `speed` at `z`, by bisection over 0-10 m/s.
+    /// The smallest u* whose profile reaches `speed` at `z`. The profile jumps down where its
+    /// laws meet (the sub-layer's top, Re_k = 5), so it can pass `speed` more than once, and a
+    /// bisection over the whole range finds any of the crossings: a scan up a geometric grid of
+    /// u* from 1e-7 to 10 m/s finds the first point at or above `speed`, then bisection between
+    /// it and the point before.
     fn friction_velocity(&self, speed: f64, z: f64) -> f64 {
-        let (mut lo, mut hi) = (0.0, 10.0);
-        for _ in 0..200 {
+        const STEPS: i32 = 40_000;
+        let ratio = (10.0f64 / 1e-7).powf(1.0 / f64::from(STEPS));
+        let (mut lo, mut hi) = (0.0, 1e-7);
+        for _ in 0..STEPS {
+            if self.profile(hi, z) >= speed {
+                break;
+            }
+            (lo, hi) = (hi, hi * ratio);
+        }
+        for _ in 0..100 {
             let mid = 0.5 * (lo + hi);
             if self.profile(mid, z) < speed {
                 lo = mid;
@@ -216,6 +235,10 @@ impl Oracle {
             } else {
                 (self.phi + beta).sin() / self.phi.sin()
             };
+            // A bed that faces down (the roof of the hole the jet digs under the orifice of the
+            // paper's bed) holds no grain: gravity pulls the grain off it, so friction cannot
+            // hold it, and Eq. 22 no longer applies.
+            let k_beta = if normal[1] < 0.0 { 0.0 } else { k_beta };
             g.u_star = u_star;
             g.z_over_delta = z * u_star / (11.6 * self.nu);
             g.tau_b = self.rho_w * u_star * u_star;
@@ -327,10 +350,11 @@ fn the_erosion_chain_of_the_flowing_flumes_grains_matches_the_oracle() {
              {compared} regions compared with the backend's",
             chains.len()
         );
-        // The top row of the 2.1 m bed is about 210 grains: a surface test that marked none,
-        // or all, would pass the checks above vacuously.
+        // The top row of the 2.1 m bed is about 210 grains, of which the front has wetted some
+        // 130 by 5 s on the paper's bed (x < 1.3 m): a surface test that marked none, or all
+        // 1,100, would pass the checks above vacuously.
         assert!(
-            (150..=400).contains(&surface),
+            (100..=400).contains(&surface),
             "t = {t} s: {surface} at the surface"
         );
     }

@@ -182,8 +182,10 @@ const LEVEL_TOLERANCE_M: f64 = 0.015;
 /// session's once the front has passed, the books whole every second, and the erosion rate
 /// bounded. The front's window is the paper's 8 s to the end of the flume +/- 50 %: the paper's
 /// Figure 9b shows the front at 8 s converging only at dp <= 4 mm; at dp = 1 cm it reached P3
-/// at 5 to 9 s, by chunking (the window was set after seeing that). It catches a front that
-/// never comes or a sheet that races ahead.
+/// at 5 to 9 s, by chunking, when a fixed apron took the jet (the window was set after seeing
+/// that). On the paper's bed, sand to the orifice, it reaches P3 at 11 s: the jet spends its
+/// momentum on the sand (docs/scour/README.md). It catches a front that never comes or a sheet
+/// that races ahead.
 #[test]
 fn ulbra_runs_the_papers_18_s_at_ci_size() {
     let (seconds, _) = run(CPU, 18);
