@@ -259,6 +259,7 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
         "step_rate_hz",
         "adapter",
         "stale_sensors",
+        "inlet_blocked_spots",
     ] {
         assert!(values.get(key).is_some(), "no {key} in {values}");
     }

@@ -1,7 +1,8 @@
 //! The erosion chain on the flowing flume, grain by grain, against an oracle written here from
 //! the paper's equations (`MODEL.md`, Eqs. 16-26) in f64: its own neighbour search (every pair),
 //! its own kernel, the friction velocity by a scan and bisection on the velocity profile (the
-//! code takes Newton steps in f32, piece by piece), and its own region of Figure 2 in the Shields-only mode.
+//! code takes Newton steps in f32, piece by piece), and its own region of Figure 2 in the
+//! Shields-only mode.
 //!
 //! The CI-size ULBRA flume (dp = 1 cm, the case's DBC walls) at 5 s, while the front's wake
 //! moves the bed, and at 15 s, once it has filled. For every sand grain: whether it lies at the

@@ -78,13 +78,9 @@ impl Simulation {
         }
         f.parked_particles = f.parked_particles.saturating_sub(placed);
         f.injected_particles += placed;
-        let doubled = match blocked_before.checked_ilog2() {
-            None => f.blocked_particles > 0,
-            Some(b) => f.blocked_particles.ilog2() > b,
-        };
-        if doubled {
-            // At each doubling: a bed that keeps the buffer busy is told of a few times, not at
-            // every column.
+        // At each doubling (the count only grows): a bed that keeps the buffer busy is told of
+        // a few times, not at every column.
+        if f.blocked_particles.checked_ilog2() != blocked_before.checked_ilog2() {
             log::warn!(
                 "t = {:.3} s: {} inlet spots left empty since the start, a particle sitting on each ({:.2} % of the inflow not placed)",
                 self.time_s,

@@ -199,8 +199,7 @@ pub fn skeleton_pressure(p: f32, rho_s: f32, rho_w: f32) -> f32 {
 /// bed counts as flat (factor 1). A normal pointing down (the roof of a hole the jet dug) holds
 /// no grain, whichever way the water flows: gravity pulls the grain off such a bed, so no
 /// friction holds it (Eq. 22 assumes the grain rests on the bed; for up-slope flow it would
-/// still give a positive factor up to beta = 180 deg - phi). The transverse angle gave 0 there
-/// before this was said, in 2-D too (atan2(0, n_v < 0) = 180 deg); the outputs are the same.
+/// still give a positive factor up to beta = 180 deg - phi).
 pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
     let v = (dim - 1) as usize;
     let horizontal = if dim == 2 { 1 } else { 2 };
