@@ -13,7 +13,7 @@ struct Sediment {
     phase: u32,              // index of the sediment in `phases`
     water_phase: u32,        // index of the water it lies in
     shields_only: u32,       // 1: Shields only, sediment not eroded or suspended is held fixed
-    pad: u32,
+    water_speed: u32,        // 1: Shields reads the water's own velocity, 0: relative to the grain
     rho_s: f32,              // saturated density, kg/m3
     rho_w: f32,              // water density, kg/m3
     d50: f32,                // median grain diameter, m

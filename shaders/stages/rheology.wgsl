@@ -23,7 +23,8 @@ override BEFORE_DT: bool = true;
 // What the rheology pass gathers over particle i's neighbours: the velocity gradient
 // (grad[b] is the column du/dx_b), and for sediment the volumes of sediment and of the
 // mixture, the kernel-weighted sediment mass of the surface test, the bed's normal, and the
-// nearest water particle's distance squared and velocity relative to i.
+// nearest water particle's distance squared and velocity, relative to i or its own
+// (`sd.water_speed`, `SedimentModel::water_speed` of pass.rs).
 struct Gathered {
     grad: mat3x3<f32>,
     sediment_volume: f32,
@@ -31,7 +32,7 @@ struct Gathered {
     kernel_mass: f32,
     normal: vec3<f32>,
     nearest_r2: f32,
-    nearest_du: vec3<f32>,
+    nearest_u: vec3<f32>,
 }
 
 // Adds neighbour j (sorted order) to the sums of particle i at pos_i moving at vel_i.
@@ -66,7 +67,7 @@ fn gather_neighbour(g: ptr<function, Gathered>, pos_i: vec3<f32>, vel_i: vec3<f3
         (*g).mixture_volume += v_j;
         if (r2 < (*g).nearest_r2) {
             (*g).nearest_r2 = r2;
-            (*g).nearest_du = du;
+            (*g).nearest_u = select(du, vr_j.xyz, sd.water_speed != 0u);
         }
     }
 }
@@ -105,9 +106,9 @@ fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
     var tau_b = 0.0;
     var tau_bcr = HUGE;
     if (at_surface) {
-        let u_star = friction_velocity(length(g.nearest_du), sqrt(g.nearest_r2), sd.ks, sd.nu_w);
+        let u_star = friction_velocity(length(g.nearest_u), sqrt(g.nearest_r2), sd.ks, sd.nu_w);
         let theta = critical_shields(u_star * sd.d50 / sd.nu_w);
-        let k = slope_factors(g.normal, g.nearest_du, sd.phi);
+        let k = slope_factors(g.normal, g.nearest_u, sd.phi);
         tau_b = sd.rho_w * u_star * u_star;
         tau_bcr = k * theta * sd.submerged_weight * sd.d50;
     }

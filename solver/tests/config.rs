@@ -457,3 +457,32 @@ fn the_case_and_the_uniform_agree_on_a_held_bed_standing_as_a_wall() {
         assert_eq!(sim.params().held_bed_is_wall(), want, "{name} {set:?}");
     }
 }
+
+#[test]
+fn the_shields_speed_reaches_both_backends_and_a_wrong_one_is_named() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+    for (set, want) in [
+        (vec![], 0),
+        (vec!["phases.1.sediment.shields_speed=relative_to_grain"], 0),
+        (vec!["phases.1.sediment.shields_speed=water"], 1),
+    ] {
+        let mut set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        set.push("numerics.dp_m=0.02".to_string());
+        let case = Case::from_path_with(&path, &set).unwrap_or_else(|e| panic!("{e}"));
+        let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &case)
+            .unwrap_or_else(|e| panic!("{set:?}: {e}"));
+        assert_eq!(sim.params().sediment.water_speed, want, "{set:?}");
+        let model = flume_solver::contract::sediment_model(&case, sim.derived()).expect("sand");
+        assert_eq!(model.water_speed, want == 1, "{set:?}");
+    }
+    let (f, r) = refused(&ULBRA.replace(
+        "      criterion: shields_only\n",
+        "      criterion: shields_only\n      shields_speed: grain\n",
+    ));
+    assert!(f.starts_with("phases"), "{f}: {r}");
+    assert!(r.contains("unknown variant `grain`"), "{r}");
+    assert!(
+        r.contains("relative_to_grain") && r.contains("water"),
+        "{r}"
+    );
+}

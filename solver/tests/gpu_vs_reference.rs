@@ -102,6 +102,15 @@ fn rheology_matches_the_cpu_with_the_waters_eddy_viscosity() {
 }
 
 #[test]
+fn rheology_matches_the_cpu_with_shields_reading_the_waters_own_speed() {
+    on_gpu(|b| {
+        let changed = stages::regions_the_shields_speed_changes(b, &stages::water_speed_case(), 25);
+        assert!(changed > 0, "no region depends on the Shields speed here");
+        stages::check_rheology(b, stages::water_speed_case(), 25);
+    });
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     on_gpu(parked::check_parked_take_no_part);
 }

@@ -217,6 +217,9 @@ pub struct SedimentConfig {
     /// When a held particle that Shields releases leaves the bed.
     #[serde(default)]
     pub erosion: Erosion,
+    /// The speed the log law of Eqs. 19-21 reads from the nearest water particle.
+    #[serde(default)]
+    pub shields_speed: ShieldsSpeed,
     /// Cap on the apparent viscosity, Pa s. Without it, mu_max = 0.125 h rho_s c0: the
     /// viscosity whose explicit diffusion limit `0.125 h^2 rho / mu` equals the acoustic step
     /// `h / c0`, so the sediment never shortens the time step below what the water needs.
@@ -245,6 +248,21 @@ pub enum Erosion {
     /// At van Rijn's (1984) pick-up rate: a particle is released in a step with the chance that
     /// the flow picks up its mass from its share of the bed (`physics::sediment::pickup`).
     VanRijnPickup,
+}
+
+/// The u of the log law (Eqs. 19-21) that the Shields test reads from the nearest water
+/// particle.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ShieldsSpeed {
+    /// Its velocity relative to the grain: what every test and figure before 2026-11-28 was
+    /// measured with. A grain carried at the water's speed sees no shear and is held at the next
+    /// step, its velocity zeroed, so how far the sand goes depends on the time step
+    /// (docs/scour/README.md, "The step moves the sand").
+    #[default]
+    RelativeToGrain,
+    /// Its own velocity, the flow's over a bed at rest, as `MODEL.md` states Eq. 20's u.
+    Water,
 }
 
 fn default_surface_mass_fraction() -> f64 {

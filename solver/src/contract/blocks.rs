@@ -23,7 +23,7 @@ pub struct SedimentGpu {
     pub phase: u32,
     pub water_phase: u32,
     pub shields_only: u32,
-    pub pad: u32,
+    pub water_speed: u32,
     pub rho_s: f32,
     pub rho_w: f32,
     pub d50: f32,

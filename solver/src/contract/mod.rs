@@ -9,7 +9,8 @@ mod blocks;
 pub use blocks::*;
 
 use crate::config::{
-    BoundaryMethod, Case, DensityDiffusion, Erosion, Integrator, Viscosity, YieldCriterion,
+    BoundaryMethod, Case, DensityDiffusion, Erosion, Integrator, ShieldsSpeed, Viscosity,
+    YieldCriterion,
 };
 use crate::derived::{self, Derived};
 use crate::flume::inlet_velocity;
@@ -196,7 +197,7 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
         phase: (k_sed + 1) as u32,
         water_phase: (k_water + 1) as u32,
         shields_only: u32::from(cfg.criterion == YieldCriterion::ShieldsOnly),
-        pad: 0,
+        water_speed: u32::from(cfg.shields_speed == ShieldsSpeed::Water),
         rho_s: rho_s as f32,
         rho_w: rho_w as f32,
         d50: cfg.d50_m as f32,
@@ -255,6 +256,7 @@ pub fn sediment_model(case: &Case, derived: &Derived) -> Option<SedimentModel> {
         sediment_phase: k_sed + 1,
         water_phase: k_water + 1,
         shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
+        water_speed: cfg.shields_speed == ShieldsSpeed::Water,
         mu_max: block.mu_max,
         pickup_per_s: block.pickup_per_s,
     })

@@ -69,6 +69,7 @@ fn sediment() -> SedimentModel {
         sediment_phase: SAND as usize,
         water_phase: WATER as usize,
         shields_only: false,
+        water_speed: false,
         mu_max: 50.0,
         pickup_per_s: 0.0,
     }

@@ -158,6 +158,7 @@ pub fn reference_sediment(
         sediment_phase: k_sed + 1,
         water_phase: k_water + 1,
         shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
+        water_speed: cfg.shields_speed == flume_solver::config::ShieldsSpeed::Water,
         mu_max: mu_max as f32,
         pickup_per_s: match cfg.erosion {
             flume_solver::config::Erosion::Threshold => 0.0,

@@ -651,6 +651,37 @@ pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
 
 /// [`shields_only_case`] with the water's sub-particle-scale eddy viscosity (C_s = 0.12), which
 /// outweighs its own viscosity forty-fold in the perturbed flow.
+/// [`shields_only_case`] with the Shields test reading the nearest water particle's own
+/// velocity (`config::ShieldsSpeed::Water`).
+pub fn water_speed_case() -> Case {
+    let mut c = shields_only_case();
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.shields_speed = flume_solver::config::ShieldsSpeed::Water;
+    }
+    c
+}
+
+/// How many particles of [`sediment_in_motion`] of `c` the oracle's rheology pass puts in
+/// another region when the Shields test reads the water's own velocity instead of its
+/// velocity relative to the grain: a comparison that can tell the two apart needs some.
+pub fn regions_the_shields_speed_changes(backend: &Backend, c: &Case, seed: u64) -> usize {
+    use flume_solver::physics::sediment::pass::{SedimentModel, rheology_pass};
+    let (sim, particles, params) = sediment_in_motion(backend, c, seed, |_| {});
+    let model = super::reference_sediment(&sim);
+    let regions = |m: &SedimentModel| -> Vec<u32> {
+        let held = vec![false; particles.len()];
+        let pass = rheology_pass(&params, m, &particles.positions, &particles.vel_rho, &held);
+        pass.iter().map(|r| r.region).collect()
+    };
+    let relative = SedimentModel {
+        water_speed: false,
+        ..model.clone()
+    };
+    let own = regions(&model);
+    let rel = regions(&relative);
+    own.iter().zip(&rel).filter(|(a, b)| a != b).count()
+}
+
 pub fn eddy_viscosity_case() -> Case {
     let mut c = shields_only_case();
     c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {

@@ -45,6 +45,9 @@ pub struct SedimentModel {
     /// fixed, and Drucker-Prager is not used. Otherwise un-yielded sediment is held until
     /// Drucker-Prager releases it ([`super::hold`]).
     pub shields_only: bool,
+    /// The Shields test reads the nearest water particle's own velocity, not its velocity
+    /// relative to the grain (`config::ShieldsSpeed`).
+    pub water_speed: bool,
     /// Largest apparent viscosity, Pa s, of the stress a particle carries. An explicit scheme
     /// is stable for `dt <= 0.125 h^2 rho / mu`; the un-yielded HBP viscosity (tau_y m, tens of
     /// thousands of Pa s for the Louvain bed) would need steps 10^2 to 10^3 times shorter than
@@ -99,10 +102,10 @@ pub struct RheologySums<L: Real = f32> {
     kernel_mass: L,
     /// `-sum_solid V_j grad_i W_ij` over sediment and walls: the bed's outward normal.
     normal: [L; 3],
-    /// Distance to the nearest water particle (infinite: none in reach) and its velocity
-    /// relative to this one.
+    /// Distance to the nearest water particle (infinite: none in reach) and its velocity,
+    /// relative to this one or its own (`SedimentModel::water_speed`).
     water_r: L,
-    water_du: [L; 3],
+    water_u: [L; 3],
 }
 
 impl<L: Real> Default for RheologySums<L> {
@@ -115,7 +118,7 @@ impl<L: Real> Default for RheologySums<L> {
             kernel_mass: zero,
             normal: [zero; 3],
             water_r: L::splat(f32::INFINITY),
-            water_du: [zero; 3],
+            water_u: [zero; 3],
         }
     }
 }
@@ -130,7 +133,7 @@ impl RheologySums<Lanes> {
                     out.grad[a][b].0[k] = s.grad[a][b];
                 }
                 out.normal[a].0[k] = s.normal[a];
-                out.water_du[a].0[k] = s.water_du[a];
+                out.water_u[a].0[k] = s.water_u[a];
             }
             out.sediment_volume.0[k] = s.sediment_volume;
             out.mixture_volume.0[k] = s.mixture_volume;
@@ -149,7 +152,7 @@ impl RheologySums<Lanes> {
             kernel_mass: self.kernel_mass.0[k],
             normal: self.normal.map(|n| n.0[k]),
             water_r: self.water_r.0[k],
-            water_du: self.water_du.map(|u| u.0[k]),
+            water_u: self.water_u.map(|u| u.0[k]),
         }
     }
 }
@@ -237,7 +240,7 @@ pub struct ShieldsChain {
     pub at_surface: bool,
     /// Distance to the nearest water particle, m (infinite with none): the z of the log law.
     pub z_m: f32,
-    /// That water particle's speed relative to this one, m/s: the u of the log law.
+    /// That water particle's speed, relative to this one or its own, m/s: the u of the log law.
     pub speed_m_per_s: f32,
     pub u_star_m_per_s: f32,
     /// Bed shear stress (Eq. 18), Pa; 0 away from the surface.
@@ -396,7 +399,12 @@ impl<'a> Rheology<'a> {
         } else {
             let nearer = near & r.lt(s.water_r);
             s.water_r = L::select(nearer, r, s.water_r);
-            for (u, d) in s.water_du.iter_mut().zip(du) {
+            let u_j = if model.water_speed {
+                std::array::from_fn(|k| c(v_j[k]))
+            } else {
+                du
+            };
+            for (u, d) in s.water_u.iter_mut().zip(u_j) {
                 *u = L::select(nearer, d, *u);
             }
         }
@@ -449,13 +457,13 @@ impl<'a> Rheology<'a> {
     }
 
     /// The Shields chain (Eqs. 16-26) of a sediment particle from its sums: whether it lies at
-    /// the bed's surface, the nearest water particle's distance and speed relative to it, the
+    /// the bed's surface, the nearest water particle's distance and speed, the
     /// friction velocity of the log law there, and the bed shear stress against its critical
     /// value on the local slope (infinite away from the surface, where Shields does not apply).
     pub fn shields_chain(&self, s: &RheologySums) -> ShieldsChain {
         let mat = &self.model.material;
         let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
-        let speed = norm3(s.water_du);
+        let speed = norm3(s.water_u);
         let mut chain = ShieldsChain {
             at_surface,
             z_m: s.water_r,
@@ -469,7 +477,7 @@ impl<'a> Rheology<'a> {
             let theta = critical_shields(u_star * mat.d50_m / mat.nu_w);
             let tau_bcr0 =
                 critical_bed_shear_stress(theta, mat.rho_s, mat.rho_w, self.g, mat.d50_m);
-            let k = slope_factors(s.normal, s.water_du, self.params.dim, mat.phi_rad);
+            let k = slope_factors(s.normal, s.water_u, self.params.dim, mat.phi_rad);
             chain.u_star_m_per_s = u_star;
             chain.tau_b_pa = bed_shear_stress(mat.rho_w, u_star);
             chain.tau_bcr_pa = sloped_critical_stress(tau_bcr0, k, 1.0);

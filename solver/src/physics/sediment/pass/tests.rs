@@ -91,6 +91,7 @@ fn flume_case() -> (Params, SedimentModel) {
         sediment_phase: 2,
         water_phase: 1,
         shields_only: true,
+        water_speed: false,
         mu_max: 50.0,
         pickup_per_s: 0.0,
     };
@@ -101,7 +102,17 @@ fn flume_case() -> (Params, SedimentModel) {
 /// particles at rest whose columns `x < 0` are of `left_phase`, under `water` (positions,
 /// moving at 0.5 m/s along +x).
 fn chain_on_flat_bed(left_phase: u32, water: &[[f32; 2]]) -> ShieldsChain {
-    let (params, model) = flume_case();
+    chain_of_grain(flume_case().1, left_phase, water, 0.0)
+}
+
+/// [`chain_on_flat_bed`] with `model`, the grain at the origin moving at `grain_u` along +x.
+fn chain_of_grain(
+    model: SedimentModel,
+    left_phase: u32,
+    water: &[[f32; 2]],
+    grain_u: f32,
+) -> ShieldsChain {
+    let params = flume_case().0;
     let pass = Rheology::new(&params, &model);
     let dp = 0.01;
     let at = |x: f32, y: f32, phase: u32| [x, y, 0.0, f32::from_bits(phase)];
@@ -110,8 +121,9 @@ fn chain_on_flat_bed(left_phase: u32, water: &[[f32; 2]]) -> ShieldsChain {
     for row in 0..5 {
         for col in -6..=6 {
             let phase = if col < 0 { left_phase } else { 2 };
+            let u = if row == 0 && col == 0 { grain_u } else { 0.0 };
             pos.push(at(col as f32 * dp, -(row as f32) * dp, phase));
-            vel.push([0.0, 0.0, 0.0, params.phases[phase as usize].rho0]);
+            vel.push([u, 0.0, 0.0, params.phases[phase as usize].rho0]);
         }
     }
     for w in water {
@@ -125,6 +137,35 @@ fn chain_on_flat_bed(left_phase: u32, water: &[[f32; 2]]) -> ShieldsChain {
         pass.add_pair((&pos[i], &vel[i]), (&pos[j], &vel[j]), &mut s);
     }
     pass.shields_chain(&s)
+}
+
+#[test]
+fn a_grain_carried_at_the_waters_speed_feels_the_flow_only_by_the_waters_own_speed() {
+    // Water 1 cm over the bed's top grain at 0.5 m/s, the grain carried along at 0.5 m/s.
+    // Relative to the grain the water stands still: no shear. By the water's own speed, the
+    // log law of Eqs. 19-21 with z = 0.01 m, ks = 3 d50 = 1.2 mm, nu = 1e-6 m2/s: rough
+    // first, z0 = 0.033 ks = 3.96e-5 m, u* = 0.41 * 0.5 / ln(0.01 / 3.96e-5) = 0.03706 m/s;
+    // ks u* / nu = 44.5 is transitional, z0 = 0.11 nu / u* + 0.033 ks = 4.253e-5 m after two
+    // rounds, u* = 0.205 / ln(235.1) = 0.037546 m/s, tau_b = rho_w u*^2 = 1.4097 Pa.
+    let dp = 0.01;
+    let water = [[0.0, dp]];
+    let relative = chain_of_grain(flume_case().1, 2, &water, 0.5);
+    assert!(relative.at_surface, "{relative:?}");
+    assert_eq!(relative.speed_m_per_s, 0.0, "{relative:?}");
+    assert_eq!(relative.tau_b_pa, 0.0, "{relative:?}");
+    let model = SedimentModel {
+        water_speed: true,
+        ..flume_case().1
+    };
+    let own = chain_of_grain(model.clone(), 2, &water, 0.5);
+    assert_eq!(own.speed_m_per_s, 0.5, "{own:?}");
+    assert!((own.z_m - dp).abs() < 1e-6, "{own:?}");
+    assert!((own.tau_b_pa - 1.4097).abs() < 2e-3, "{own:?}");
+    assert!(own.tau_b_pa > own.tau_bcr_pa, "{own:?}");
+    // A grain at rest feels the same either way.
+    let at_rest = chain_of_grain(model, 2, &water, 0.0);
+    assert_eq!(at_rest, own, "the grain at rest");
+    assert_eq!(chain_of_grain(flume_case().1, 2, &water, 0.0), own);
 }
 
 /// The chain's critical stress is a flat bed's for its friction velocity (slope factor 1).
