@@ -4,6 +4,7 @@
 mod common;
 
 use common::parked;
+use common::sand_stages;
 use common::stages::{self, case};
 use flume_solver::Backend;
 
@@ -67,7 +68,7 @@ fn probe_phase_fullness_matches_the_oracle() {
 
 #[test]
 fn two_verlet_steps_with_held_sand_match_the_oracle() {
-    stages::check_verlet_steps_with_held_sand(&CPU);
+    sand_stages::check_verlet_steps_with_held_sand(&CPU);
 }
 
 #[test]
@@ -77,17 +78,17 @@ fn two_verlet_steps_with_the_held_bed_as_a_wall_match_the_oracle() {
 
 #[test]
 fn rheology_matches_the_oracle_drucker_prager_shields() {
-    stages::check_rheology(&CPU, case("tests/cases/sediment_bed_2d.yaml"), 21);
+    sand_stages::check_rheology(&CPU, case("tests/cases/sediment_bed_2d.yaml"), 21);
 }
 
 #[test]
 fn rheology_matches_the_oracle_shields_only() {
-    stages::check_rheology(&CPU, stages::shields_only_case(), 22);
+    sand_stages::check_rheology(&CPU, sand_stages::shields_only_case(), 22);
 }
 
 #[test]
 fn rheology_matches_the_oracle_with_the_waters_eddy_viscosity() {
-    stages::check_rheology(&CPU, stages::eddy_viscosity_case(), 24);
+    sand_stages::check_rheology(&CPU, sand_stages::eddy_viscosity_case(), 24);
 }
 
 #[test]

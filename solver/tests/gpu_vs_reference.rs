@@ -4,6 +4,7 @@
 mod common;
 
 use common::parked;
+use common::sand_stages;
 use common::stages::{self, case};
 
 /// Runs a shared stage check on the GPU, one GPU test at a time.
@@ -73,7 +74,7 @@ fn probe_interpolate_phase_fullness_matches_the_cpu() {
 
 #[test]
 fn two_verlet_steps_with_held_sand_match_the_cpu_steps() {
-    on_gpu(stages::check_verlet_steps_with_held_sand);
+    on_gpu(sand_stages::check_verlet_steps_with_held_sand);
 }
 
 #[test]
@@ -88,25 +89,26 @@ fn two_symplectic_steps_with_the_held_bed_as_a_wall_match_the_cpu_backend() {
 
 #[test]
 fn rheology_matches_the_cpu_drucker_prager_shields() {
-    on_gpu(|b| stages::check_rheology(b, case("tests/cases/sediment_bed_2d.yaml"), 21));
+    on_gpu(|b| sand_stages::check_rheology(b, case("tests/cases/sediment_bed_2d.yaml"), 21));
 }
 
 #[test]
 fn rheology_matches_the_cpu_shields_only() {
-    on_gpu(|b| stages::check_rheology(b, stages::shields_only_case(), 22));
+    on_gpu(|b| sand_stages::check_rheology(b, sand_stages::shields_only_case(), 22));
 }
 
 #[test]
 fn rheology_matches_the_cpu_with_the_waters_eddy_viscosity() {
-    on_gpu(|b| stages::check_rheology(b, stages::eddy_viscosity_case(), 24));
+    on_gpu(|b| sand_stages::check_rheology(b, sand_stages::eddy_viscosity_case(), 24));
 }
 
 #[test]
 fn rheology_matches_the_cpu_with_shields_reading_the_waters_own_speed() {
     on_gpu(|b| {
-        let changed = stages::regions_the_shields_speed_changes(b, &stages::water_speed_case(), 25);
+        let changed =
+            sand_stages::regions_the_shields_speed_changes(b, &sand_stages::water_speed_case(), 25);
         assert!(changed > 0, "no region depends on the Shields speed here");
-        stages::check_rheology(b, stages::water_speed_case(), 25);
+        sand_stages::check_rheology(b, sand_stages::water_speed_case(), 25);
     });
 }
 

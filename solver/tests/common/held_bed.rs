@@ -4,9 +4,10 @@
 //! (`interaction::interact_with_bed_walls`) and whose integrator gives them the density that
 //! pass gave (`integrate::bed_wall`).
 
-use super::stages::{
-    TwoSteps, assert_step_close, sediment_in_motion, shields_only_case, two_steps_of_sand_in_motion,
+use super::sand_stages::{
+    TwoSteps, sediment_in_motion, shields_only_case, two_steps_of_sand_in_motion,
 };
+use super::stages::assert_step_close;
 use flume_solver::Backend;
 use flume_solver::config::BoundaryMethod;
 use flume_solver::physics::sediment::{pass, stress};

@@ -5,6 +5,7 @@
 pub mod held_bed;
 pub mod parked;
 pub mod probe;
+pub mod sand_stages;
 pub mod stages;
 
 use flume_solver::{Backend, GpuContext};

@@ -1,0 +1,320 @@
+//! The sediment stages' checks against their CPU oracles in `flume_solver::physics::sediment`,
+//! for any backend (`gpu_vs_reference.rs` on lavapipe, `cpu_vs_reference.rs`): the rheology
+//! pass, the release of held sand and the multiphase forces, on a sand bed in motion, and the
+//! sediment cases they run on. Tolerances as in [`super::stages`].
+
+use super::stages::{assert_close, assert_step_close, case};
+use flume_solver::physics::{integrate, interaction};
+use flume_solver::{Backend, Case};
+
+/// A sediment case started from its perturbed lattice (random velocities up to 0.3 m/s: strain
+/// rates of tens per second, bed shear stresses on both sides of the Shields threshold, yielded
+/// and un-yielded sediment) with the lower three quarters of the bed at rest, so that the
+/// first rheology pass holds them and the release stage has held sand under moving sand to
+/// decide on. `prepare` may then change the particles before the simulation takes them.
+pub fn sediment_in_motion(
+    backend: &Backend,
+    c: &Case,
+    seed: u64,
+    prepare: impl FnOnce(&mut flume_solver::Particles),
+) -> (
+    flume_solver::Simulation,
+    flume_solver::Particles,
+    flume_solver::physics::Params,
+) {
+    let lattice = flume_solver::Simulation::new(backend.clone(), c).expect("builds");
+    let mut particles = super::perturbed(&lattice, 0.3, seed);
+    let at_rest_below = 0.75 * c.fluid_blocks[0].max_m[1] as f32;
+    for i in 0..particles.len() {
+        if particles.phase(i) == 2 && particles.positions[i][1] < at_rest_below {
+            particles.vel_rho[i][..3].fill(0.0);
+        }
+    }
+    prepare(&mut particles);
+    let sim = flume_solver::Simulation::from_particles(backend.clone(), c, particles.clone())
+        .expect("builds");
+    let params = super::reference_params(&sim);
+    (sim, particles, params)
+}
+
+/// A sand bed in motion ([`sediment_in_motion`], with `prepare`) before and after two steps of
+/// different lengths on `backend`, with the oracle's parameters and sediment model.
+pub struct TwoSteps {
+    pub particles: flume_solver::Particles,
+    pub params: flume_solver::physics::Params,
+    pub model: flume_solver::physics::sediment::pass::SedimentModel,
+    pub after: flume_solver::Particles,
+    pub dt: f32,
+    pub dt2: f32,
+}
+
+pub fn two_steps_of_sand_in_motion(
+    backend: &Backend,
+    c: &Case,
+    seed: u64,
+    prepare: impl FnOnce(&mut flume_solver::Particles),
+) -> TwoSteps {
+    let (mut sim, particles, params) = sediment_in_motion(backend, c, seed, prepare);
+    let model = super::reference_sediment(&sim);
+    let (dt, dt2) = (2.0e-5f32, 1.5e-5f32);
+    sim.advance_to(f64::from(dt)).expect("step 1");
+    sim.advance_to(f64::from(dt) + f64::from(dt2))
+        .expect("step 2");
+    assert_eq!(sim.steps(), 2);
+    let after = sim.read_particles().expect("readback");
+    TwoSteps {
+        particles,
+        params,
+        model,
+        after,
+        dt,
+        dt2,
+    }
+}
+
+/// One round of `check_rheology`: the GPU's rheology, release and force passes from the holds
+/// `held` against the CPU's. Returns the holds after it, how many held particles it released
+/// and the count of each region (walls, 1-5).
+fn check_rheology_round(
+    sim: &mut flume_solver::Simulation,
+    params: &flume_solver::physics::Params,
+    model: &flume_solver::physics::sediment::pass::SedimentModel,
+    particles: &flume_solver::Particles,
+    held: &[bool],
+) -> (Vec<bool>, usize, [usize; 6]) {
+    use flume_solver::physics::sediment::{hold, pass, stress};
+    let (pos, vel) = (&particles.positions, &particles.vel_rho);
+    let (gpu_forces, gpu_dt) = sim.compute_forces().expect("forces");
+    let gpu_regions = sim.regions().expect("regions");
+    let mut rheology = pass::rheology_pass(params, model, pos, vel, held);
+    let held_in_rheology: Vec<bool> = rheology.iter().map(|r| r.held).collect();
+    hold::release_pass(params, model, pos, vel, &mut rheology);
+    let released = (0..rheology.len())
+        .filter(|&i| held_in_rheology[i] && !rheology[i].held)
+        .count();
+    let cpu_regions: Vec<u32> = rheology
+        .iter()
+        .map(|r| r.region | if r.held { 256 } else { 0 })
+        .collect();
+    // A comparison at a threshold (Shields, Drucker-Prager, c_v, the surface mass) may go
+    // either way under f32 rounding of sums taken in different orders; none did here.
+    let differ: Vec<usize> = (0..cpu_regions.len())
+        .filter(|&i| cpu_regions[i] != gpu_regions[i])
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "{} regions differ, first: particle {} gpu {} cpu {}",
+        differ.len(),
+        differ[0],
+        gpu_regions[differ[0]],
+        cpu_regions[differ[0]]
+    );
+    let mut count = [0usize; 6];
+    for r in &cpu_regions {
+        count[(*r & 255) as usize] += 1;
+    }
+    let mut cpu = interaction::interact(params, pos, vel);
+    let stress = stress::stress_divergence(params, pos, vel, &rheology);
+    for (f, s) in cpu.forces.iter_mut().zip(&stress) {
+        for k in 0..3 {
+            f[k] += s[k];
+        }
+    }
+    // The Shields-only mode's held sand is fixed where it stands (these cases' walls are
+    // DBC): the backends sum only its density rate, give it no acceleration and let it not
+    // bound the step (`interaction::Side::fixed`).
+    for ((f, dt), r) in cpu.forces.iter_mut().zip(&mut cpu.dt_limit).zip(&rheology) {
+        if r.held && model.shields_only {
+            f[..3].fill(0.0);
+            *dt = f32::INFINITY;
+        }
+    }
+    let dim = params.dim as usize;
+    assert_close(
+        "multiphase acceleration",
+        &gpu_forces,
+        &cpu.forces,
+        dim,
+        1e-4,
+    );
+    let drho: Vec<[f32; 4]> = gpu_forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
+    let drho_cpu: Vec<[f32; 4]> = cpu.forces.iter().map(|f| [f[3], 0.0, 0.0, 0.0]).collect();
+    assert_close("multiphase density rate", &drho, &drho_cpu, 1, 1e-4);
+    let h = params.h;
+    let cpu_dt = cpu
+        .dt_limit
+        .iter()
+        .zip(&rheology)
+        .zip(vel)
+        .map(|((&dt, r), v)| {
+            if r.mu > 0.0 {
+                dt.min(0.125 * h * h * v[3] / r.mu)
+            } else {
+                dt
+            }
+        })
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        ((gpu_dt - cpu_dt) / cpu_dt).abs() < 1e-4,
+        "stable step: gpu {gpu_dt} cpu {cpu_dt}"
+    );
+    (rheology.iter().map(|r| r.held).collect(), released, count)
+}
+
+/// The rheology pass, the release of held sediment and the multiphase force pass against
+/// `sediment::pass` and `sediment::hold`: regions word for word, accelerations (pressure plus
+/// stress divergence) and density rates within 1e-4 of the largest, and the stable step with
+/// each particle's viscous limit. Two passes, the second starting from the holds of the first
+/// as a step starts from the last one's.
+pub fn check_rheology(backend: &Backend, c: Case, seed: u64) {
+    let (mut sim, particles, params) = sediment_in_motion(backend, &c, seed, |_| {});
+    let model = super::reference_sediment(&sim);
+    let mut held = vec![false; particles.len()];
+    let (mut released, mut count) = (0, [0usize; 6]);
+    for round in 1..=2 {
+        let (held_after, freed, regions) =
+            check_rheology_round(&mut sim, &params, &model, &particles, &held);
+        eprintln!(
+            "{} round {round}: regions (walls, 1-5) {regions:?} agree",
+            c.name
+        );
+        (held, count) = (held_after, regions);
+        released += freed;
+    }
+    // Every sediment region this test exists for occurs; Drucker-Prager both releases held
+    // sediment and keeps some held.
+    let wanted: &[usize] = if model.shields_only {
+        &[1, 3]
+    } else {
+        &[1, 2, 3]
+    };
+    for &r in wanted {
+        assert!(count[r] > 0, "no particle in region {r}: {count:?}");
+    }
+    eprintln!("{released} held particles released by their neighbours' stress");
+    if model.shields_only {
+        assert_eq!(released, 0, "the Shields-only mode released held sediment");
+    } else {
+        assert!(released > 0, "no held particle was released");
+    }
+}
+
+/// Two Verlet steps of a sand bed in motion against the CPU: the forces with the rheology and
+/// release passes, then `integrate::verlet` with the holds of `integrate::hold_at_rest`; the
+/// second step starts from the first one's holds and from its `vel_rho_prev`, so a grain held
+/// for the first step and released in the second is checked too (when there is one).
+pub fn check_verlet_steps_with_held_sand(backend: &Backend) {
+    use flume_solver::physics::sediment::{hold, pass, stress};
+    let c = case("tests/cases/sediment_bed_2d.yaml");
+    let TwoSteps {
+        particles,
+        params,
+        model,
+        after,
+        dt,
+        dt2,
+    } = two_steps_of_sand_in_motion(backend, &c, 23, |_| {});
+
+    let n = particles.len();
+    let forces = |pos: &[[f32; 4]], vel: &[[f32; 4]], held_before: &[bool]| {
+        let mut r = pass::rheology_pass(&params, &model, pos, vel, held_before);
+        hold::release_pass(&params, &model, pos, vel, &mut r);
+        let mut f = interaction::interact(&params, pos, vel).forces;
+        for (f, s) in f
+            .iter_mut()
+            .zip(stress::stress_divergence(&params, pos, vel, &r))
+        {
+            for k in 0..3 {
+                f[k] += s[k];
+            }
+        }
+        (f, r.iter().map(|r| r.held).collect::<Vec<bool>>())
+    };
+    let (pos0, vel0) = (&particles.positions, &particles.vel_rho);
+    let clamp = params.clamp_negative_pressure;
+    let (f0, held1) = forces(pos0, vel0, &vec![false; n]);
+    let mut s1 = integrate::verlet(&params.phases, dt, 0.0, true, pos0, vel0, vel0, &f0);
+    integrate::hold_at_rest(&params.phases, clamp, pos0, vel0, &held1, &mut s1);
+    let (f1, held2) = forces(&s1.0, &s1.1, &held1);
+    let mut s2 = integrate::verlet(&params.phases, dt2, dt, false, &s1.0, &s1.1, &s1.2, &f1);
+    integrate::hold_at_rest(&params.phases, clamp, &s1.0, &s1.1, &held2, &mut s2);
+    let count = |h: &[bool]| h.iter().filter(|&&h| h).count();
+    let released = (0..n).filter(|&i| held1[i] && !held2[i]).count();
+    eprintln!(
+        "held {} then {}; {released} released in the second step",
+        count(&held1),
+        count(&held2)
+    );
+    assert!(count(&held1) > 0 && count(&held2) > 0, "nothing held");
+    assert_step_close(&after, &s2.0, &s2.1, &[&f0, &f1], dt, 2.0);
+    // Sand held in both steps is exactly where it started, at rest.
+    for i in (0..n).filter(|&i| held1[i] && held2[i]) {
+        assert_eq!(after.positions[i], pos0[i], "held particle {i} moved");
+        assert_eq!(
+            after.vel_rho[i][..3],
+            [0.0; 3],
+            "held particle {i} has a velocity"
+        );
+    }
+}
+
+/// [`shields_only_case`] with the Shields test reading the nearest water particle's own
+/// velocity (`config::ShieldsSpeed::Water`).
+pub fn water_speed_case() -> Case {
+    let mut c = shields_only_case();
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.shields_speed = flume_solver::config::ShieldsSpeed::Water;
+    }
+    c
+}
+
+/// How many particles of [`sediment_in_motion`] of `c` the oracle's rheology pass puts in
+/// another region when the Shields test reads the water's own velocity instead of its
+/// velocity relative to the grain: a comparison that can tell the two apart needs some.
+pub fn regions_the_shields_speed_changes(backend: &Backend, c: &Case, seed: u64) -> usize {
+    use flume_solver::physics::sediment::pass::{SedimentModel, rheology_pass};
+    let (sim, particles, params) = sediment_in_motion(backend, c, seed, |_| {});
+    let model = super::reference_sediment(&sim);
+    let regions = |m: &SedimentModel| -> Vec<u32> {
+        let held = vec![false; particles.len()];
+        let pass = rheology_pass(&params, m, &particles.positions, &particles.vel_rho, &held);
+        pass.iter().map(|r| r.region).collect()
+    };
+    let relative = regions(&SedimentModel {
+        water_speed: false,
+        ..model.clone()
+    });
+    let own = regions(&model);
+    own.iter().zip(&relative).filter(|(a, b)| a != b).count()
+}
+
+/// [`shields_only_case`] with the water's sub-particle-scale eddy viscosity (C_s = 0.12), which
+/// outweighs its own viscosity forty-fold in the perturbed flow.
+pub fn eddy_viscosity_case() -> Case {
+    let mut c = shields_only_case();
+    c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {
+        alpha: 0.05,
+        smagorinsky_cs: 0.12,
+        eddy_m2_per_s: 0.0,
+    };
+    c
+}
+
+/// The sediment bed in the Shields-only mode, with artificial viscosity on top of the stress
+/// and without tension, as the flume case runs (the perturbed densities, 1 % either side of
+/// rest, give negative pressures).
+pub fn shields_only_case() -> Case {
+    let mut c = case("tests/cases/sediment_bed_2d.yaml");
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.criterion = flume_solver::config::YieldCriterion::ShieldsOnly;
+        s.hbp_m_s = 0.0;
+        s.hbp_n = 1.0;
+    }
+    c.numerics.viscosity = flume_solver::config::Viscosity::Multiphase {
+        alpha: 0.05,
+        smagorinsky_cs: 0.0,
+        eddy_m2_per_s: 0.0,
+    };
+    c.numerics.clamp_negative_pressure = true;
+    c
+}
