@@ -7,7 +7,7 @@ Usage: python3 scripts/figure10_chart.py LABEL=RUNS.csv [LABEL=RUNS.csv ...] > c
 Each CSV has a row per run with the columns `ks_over_d50` and `eroded_kg_per_m` (as
 `docs/scour/figure10_bed_slope.csv` and `figure10_ks_repeats.csv`); each becomes one bar per
 ks/d50, in the order given. The y axis runs to 3 kg/m as the paper's does (further if a run
-goes over), and the band at ks/d50 = 3 marks 0.5-3 kg/m, the paper's bar there matching the
+goes over, or would reach the legend), and the band at ks/d50 = 3 marks 0.5-3 kg/m, the paper's bar there matching the
 experiment's. Writes SVG: it needs nothing beyond Python's standard library.
 """
 
@@ -68,6 +68,11 @@ class Frame:
 def svg(ladders):
     ks_values = sorted({k for _, runs in ladders for k in runs})
     top = max([PAPER_AXIS_KG_PER_M] + [max(v) for _, r in ladders for v in r.values()])
+    # The legend stands over the slots right of ks/d50 = 3 (`labels`): their bars stay under it.
+    legend_px = 24 + 16 * (len(ladders) + 1)
+    under_legend = [max(v) for _, r in ladders for k, v in r.items() if k > 3.0]
+    plot_h = HEIGHT - TOP - BOTTOM
+    top = max([top] + [v / (1 - legend_px / plot_h) for v in under_legend])
     frame = Frame(float(int(top * 2 + 0.999)) / 2, len(ks_values))
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" '
