@@ -17,6 +17,9 @@ from collections import defaultdict
 
 WIDTH, HEIGHT = 720, 420
 LEFT, RIGHT, TOP, BOTTOM = 70, 20, 40, 60
+PLOT_W, PLOT_H = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
+# The legend's first row, under the plot's top, and the height of a row, px.
+LEGEND_Y0, LEGEND_ROW = 24, 16
 COLOURS = ["#9e9e9e", "#1f77b4", "#ff7f0e", "#2ca02c"]
 USAGE = "usage: python3 scripts/figure10_chart.py LABEL=RUNS.csv [LABEL=RUNS.csv ...] > chart.svg"
 PAPER_AXIS_KG_PER_M = 3.0
@@ -58,7 +61,7 @@ class Frame:
 
     def __init__(self, top, slots):
         self.top = top
-        self.plot_w, self.plot_h = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
+        self.plot_w, self.plot_h = PLOT_W, PLOT_H
         self.slot = self.plot_w / slots
 
     def y(self, v):
@@ -68,11 +71,11 @@ class Frame:
 def svg(ladders):
     ks_values = sorted({k for _, runs in ladders for k in runs})
     top = max([PAPER_AXIS_KG_PER_M] + [max(v) for _, r in ladders for v in r.values()])
-    # The legend stands over the slots right of ks/d50 = 3 (`labels`): their bars stay under it.
-    legend_px = 24 + 16 * (len(ladders) + 1)
-    under_legend = [max(v) for _, r in ladders for k, v in r.items() if k > 3.0]
-    plot_h = HEIGHT - TOP - BOTTOM
-    top = max([top] + [v / (1 - legend_px / plot_h) for v in under_legend])
+    # The bars in the legend's slots stay under its last row (one row spare).
+    legend_px = LEGEND_Y0 + LEGEND_ROW * (len(ladders) + 1)
+    first = legend_slot(ks_values)
+    under_legend = [max(r[k]) for _, r in ladders for k in ks_values[first:] if k in r]
+    top = max([top] + [v / (1 - legend_px / PLOT_H) for v in under_legend])
     frame = Frame(float(int(top * 2 + 0.999)) / 2, len(ks_values))
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" '
@@ -135,6 +138,12 @@ def bars(frame, ks_values, ladders):
     return out
 
 
+def legend_slot(ks_values):
+    """The slot the legend starts over: the fourth, right of the band at ks/d50 = 3 on the
+    paper's ladder, or the last of a shorter one. `svg` keeps the bars from there on under it."""
+    return min(3, len(ks_values) - 1)
+
+
 def labels(frame, ks_values, ladders):
     """The axes, their titles and the legend."""
     y0 = frame.y(0)
@@ -147,10 +156,9 @@ def labels(frame, ks_values, ladders):
     ]
     legend = [(label, COLOURS[n]) for n, (label, _) in enumerate(ladders)]
     legend.append(("the aim at ks/d50 = 3: 0.5-3 kg/m", "#cfe8cf"))
-    # Right of the band at ks/d50 = 3 and under the axis' top, where the bars stay low.
-    lx = LEFT + frame.slot * min(3, len(ks_values) - 1) + 10
+    lx = LEFT + frame.slot * legend_slot(ks_values) + 10
     for n, (label, colour) in enumerate(legend):
-        ly = TOP + 24 + 16 * n
+        ly = TOP + LEGEND_Y0 + LEGEND_ROW * n
         out.append(
             f'<rect x="{lx:.1f}" y="{ly - 9}" width="12" height="10" fill="{colour}"/>'
             f'<text x="{lx + 18:.1f}" y="{ly}">{escape(label)}</text>'

@@ -167,9 +167,11 @@ fn bed_load_names_what_it_cannot_read() {
 /// `figure10_chart.py` draws each ks/d50's mean as the bar and the runs' range as the whisker,
 /// on the paper's axis to 3 kg/m unless a run goes over. By hand, for a plot 320 px high from
 /// y = 40: runs of 0.5 and 1.0 kg/m give a bar to 0.75 (y = 40 + 320 (1 - 0.75 / 3) = 280.0)
-/// and a whisker from 0.5 (306.7) to 1.0 (253.3); a run of 4.2 kg/m stretches the axis to 4.5.
-/// Right of ks/d50 = 3 the bars stay under the legend (24 + 16 px a row, one ladder and the
-/// aim: 56 px): a run of 3 kg/m at ks/d50 = 7 needs 3 / (1 - 56 / 320) = 3.64, an axis to 4.
+/// and a whisker from 0.5 (306.7) to 1.0 (253.3); a run of 4.2 kg/m at ks/d50 = 3, left of the
+/// legend, stretches the axis to 4.5. The bars of the legend's slots (from the fourth, or the
+/// last of a shorter ladder) stay under it (24 + 16 px a row, one ladder and the aim: 56 px):
+/// a run of 3 kg/m at ks/d50 = 7 needs 3 / (1 - 56 / 320) = 3.64, an axis to 4, and 4.2 kg/m
+/// alone in the legend's slot 5.09, an axis to 5.5.
 #[test]
 fn figure10_chart_draws_the_mean_and_the_range_of_the_runs() {
     let dir = std::env::temp_dir().join(format!("flume-fig10-{}", std::process::id()));
@@ -194,9 +196,12 @@ fn figure10_chart_draws_the_mean_and_the_range_of_the_runs() {
     assert!(bar.is_some_and(|l| l.contains("y=\"280.0\"")), "{svg}");
     assert!(svg.contains("y1=\"306.7\" y2=\"253.3\""), "{svg}");
     assert!(!svg.contains(">3.5<"), "{svg}");
-    let out = chart("3,4.2\n");
+    let out = chart("3,4.2\n7,0.1\n");
     let svg = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(svg.contains(">4.5<") && !svg.contains(">5<"), "{svg}");
+    let out = chart("3,4.2\n");
+    let svg = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(svg.contains(">5.5<") && !svg.contains(">6<"), "{svg}");
     let out = chart("3,0.5\n7,3.0\n");
     let svg = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(svg.contains(">4<") && !svg.contains(">4.5<"), "{svg}");
