@@ -15,6 +15,8 @@ import csv
 import sys
 from collections import defaultdict
 
+from labelled_args import labelled_paths
+
 WIDTH, HEIGHT = 720, 420
 LEFT, RIGHT, TOP, BOTTOM = 70, 20, 40, 60
 PLOT_W, PLOT_H = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
@@ -43,14 +45,7 @@ def ladder(path):
 
 
 def parse_args(argv):
-    ladders = []
-    for arg in argv:
-        label, sep, path = arg.partition("=")
-        if not sep or not label or not path:
-            sys.exit(f"expected LABEL=RUNS.csv, got {arg!r}")
-        ladders.append((label, ladder(path)))
-    if not ladders:
-        sys.exit(USAGE)
+    ladders = [(label, ladder(path)) for label, path in labelled_paths(argv, USAGE, "RUNS.csv")]
     if len(ladders) > len(COLOURS):
         sys.exit(f"at most {len(COLOURS)} ladders")
     return ladders

@@ -214,3 +214,52 @@ fn figure10_chart_draws_the_mean_and_the_range_of_the_runs() {
     assert!(!err.contains("Traceback"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `figure9_chart.py` draws each run of a front table as a line, leaving out the times it was
+/// dry. By hand, for a plot 440 px wide from x = 70 and 320 px high from y = 40, to 8 s and
+/// over the flume's 2.5 m: run a at (4 s, 1.25 m) and (8 s, 2.5 m) gives the points (290.0,
+/// 200.0) and (510.0, 40.0); run b at (0 s, 0.1 m) and (8 s, 0.5 m) gives (70.0, 347.2) and
+/// (510.0, 296.0). A run to 10 s stretches the axis to 10 s, its end then at x = 510.0.
+#[test]
+fn figure9_chart_draws_each_run_s_front_against_time() {
+    let dir = std::env::temp_dir().join(format!("flume-fig9-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let chart = |table: &str| {
+        let path = dir.join("front.csv");
+        std::fs::write(&path, table).expect("csv");
+        Command::new("python3")
+            .arg(repo_file("scripts/figure9_chart.py"))
+            .arg(format!("L={}", path.display()))
+            .output()
+            .expect("python3 runs")
+    };
+    let out = chart("time_s,front_m out/a,front_m out/b\n0,,0.1\n4,1.25,\n8,2.5,0.5\n");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(svg.contains("points=\"290.0,200.0 510.0,40.0\""), "{svg}");
+    assert!(svg.contains("points=\"70.0,347.2 510.0,296.0\""), "{svg}");
+    assert!(svg.contains(">L, a<") && svg.contains(">L, b<"), "{svg}");
+    assert!(!svg.contains(">9<"), "{svg}");
+    let out = chart("time_s,front_m out/a\n0,0.5\n10,1.0\n");
+    let svg = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(svg.contains(">10<"), "{svg}");
+    assert!(svg.contains("points=\"70.0,296.0 510.0,232.0\""), "{svg}");
+    let out = chart("ks_over_d50,eroded_kg_per_m\n3,0.5\n");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("not a front table"),
+        "{err}"
+    );
+    let out = chart("time_s,front_m out/a\nlate,0.5\n");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("not a front table"),
+        "{err}"
+    );
+    assert!(!err.contains("Traceback"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
