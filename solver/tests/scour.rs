@@ -8,26 +8,14 @@ mod common;
 use flume_solver::Particles;
 use flume_solver::{BoundaryConditions, Case, Simulation};
 
-use common::ulbra_ci;
+use common::{SAND, mobilised, ulbra_ci};
 
-const SAND: u32 = 2;
 const WATER: u32 = 1;
 /// 2 m3/h.
 const Q_ULBRA: f64 = 2.0 / 3600.0;
 
 fn count_phase(p: &Particles, phase: u32) -> usize {
     (0..p.len()).filter(|&i| p.phase(i) == phase).count()
-}
-
-/// Sand particles more than dp / 2 from where they started.
-fn mobilised(start: &Particles, now: &Particles, dp: f32) -> usize {
-    (0..now.len())
-        .filter(|&i| start.phase(i) == SAND)
-        .filter(|&i| {
-            let (a, b) = (start.positions[i], now.positions[i]);
-            now.phase(i) != SAND || (a[0] - b[0]).hypot(a[1] - b[1]) > 0.5 * dp
-        })
-        .count()
 }
 
 /// Nothing leaks: the particle count is fixed, and the mass now plus what the collected sand

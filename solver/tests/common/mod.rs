@@ -8,7 +8,7 @@ pub mod probe;
 pub mod sand_stages;
 pub mod stages;
 
-use flume_solver::{Backend, GpuContext};
+use flume_solver::{Backend, GpuContext, Particles};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 /// GPU tests run one at a time: lavapipe already uses every core.
@@ -35,6 +35,21 @@ pub fn gpu() -> Option<Arc<GpuContext>> {
         }
     })
     .clone()
+}
+
+/// The particle phase of a case's sand: its second fluid phase (0 is the walls; every sediment
+/// case here lists water first).
+pub const SAND: u32 = 2;
+
+/// Sand particles more than dp / 2 from where they started, or no longer sand (collected).
+pub fn mobilised(start: &Particles, now: &Particles, dp: f32) -> usize {
+    (0..now.len())
+        .filter(|&i| start.phase(i) == SAND)
+        .filter(|&i| {
+            let (a, b) = (start.positions[i], now.positions[i]);
+            now.phase(i) != SAND || (a[0] - b[0]).hypot(a[1] - b[1]) > 0.5 * dp
+        })
+        .count()
 }
 
 /// The ULBRA flume at CI size: dp = 1 cm (the bed 5 particles deep, the inlet 2 high), a
