@@ -38,6 +38,9 @@ pub struct FlumeState {
     /// (`crate::health`), and how many of them were sediment (recycled as water).
     pub excluded_particles: u64,
     pub excluded_sediment: u64,
+    /// Water particles the bed's pores took (and parked) since the start
+    /// (`simulation::PoreColumns`).
+    pub soaked_particles: u64,
 }
 
 /// Share of the inflow's particles left unplaced, 0-1: `blocked` spots against `placed` ones.
@@ -73,6 +76,7 @@ impl FlumeState {
             injected_particles: 0,
             excluded_particles: 0,
             excluded_sediment: 0,
+            soaked_particles: 0,
         })
     }
 
@@ -188,6 +192,7 @@ mod tests {
             injected_particles: 0,
             excluded_particles: 0,
             excluded_sediment: 0,
+            soaked_particles: 0,
         }
     }
 

@@ -71,6 +71,8 @@ pub struct FlumeObservation {
     /// first to their sum.
     pub blocked_particles: u64,
     pub injected_particles: u64,
+    /// Water particles the bed's pores have taken (and parked) since the start.
+    pub soaked_particles: u64,
     /// Particles excluded for a density out of range since the start (recycled through the
     /// inlet; `crate::health`), and how many of them were sediment.
     pub excluded_particles: u64,

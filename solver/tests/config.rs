@@ -268,6 +268,24 @@ fn sediment_and_open_flume_values_are_refused_with_field_and_reason() {
             "open_flume.sill",
             "ends a sediment bed",
         ),
+        (
+            "ks_over_d50: 3.0",
+            "ks_over_d50: 3.0\n      pores: { porosity: 1.4, conductivity_m_per_s: 1.5e-3, suction_m: 0.05 }",
+            "phases[1].sediment.pores.porosity",
+            "between 0 and 1",
+        ),
+        (
+            "ks_over_d50: 3.0",
+            "ks_over_d50: 3.0\n      pores: { porosity: 0.4, conductivity_m_per_s: 0.0, suction_m: 0.05 }",
+            "phases[1].sediment.pores.conductivity_m_per_s",
+            "positive",
+        ),
+        (
+            "ks_over_d50: 3.0",
+            "ks_over_d50: 3.0\n      pores: { porosity: 0.4, conductivity_m_per_s: 1.5e-3, suction_m: -0.05 }",
+            "phases[1].sediment.pores.suction_m",
+            ">= 0",
+        ),
     ] {
         assert!(ULBRA.contains(from), "{from}");
         let (f, r) = refused(&ULBRA.replace(from, to));
@@ -485,4 +503,17 @@ fn the_shields_speed_reaches_both_backends_and_a_wrong_one_is_named() {
         r.contains("relative_to_grain") && r.contains("water"),
         "{r}"
     );
+}
+
+/// The water the pores take is parked, and only an open flume parks: a closed tank's bed with
+/// pores is refused by name, not run without them.
+#[test]
+fn pores_need_an_open_flume() {
+    let tank = include_str!("cases/sediment_bed_2d.yaml");
+    let from = "ks_over_d50: 3.0";
+    assert!(tank.contains(from));
+    let to = "ks_over_d50: 3.0\n      pores: { porosity: 0.4, conductivity_m_per_s: 1.5e-3, suction_m: 0.05 }";
+    let (f, r) = refused(&tank.replace(from, to));
+    assert_eq!(f, "phases[1].sediment.pores");
+    assert!(r.contains("open flume"), "{r}");
 }

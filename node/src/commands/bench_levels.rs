@@ -58,6 +58,7 @@ struct Books {
     injected: u64,
     eroded: u64,
     excluded: u64,
+    soaked: u64,
 }
 
 pub fn run(flume: &Path, set: &[String], runs: &[LevelRun]) -> Result<()> {
@@ -144,6 +145,7 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
             injected: f.injected_particles,
             eroded: f.eroded_particles,
             excluded: f.excluded_particles,
+            soaked: f.soaked_particles,
         };
         history.push((books, obs));
     }
@@ -287,12 +289,13 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
         return;
     }
     let d = |a: u64, b: u64| a as f64 - b as f64;
-    // A parked particle left over the weir, reached the collector (sediment) or was excluded;
-    // the inlet takes its particles from the parked ones.
+    // A parked particle left over the weir, reached the collector (sediment), was excluded or
+    // went into the bed's pores; the inlet takes its particles from the parked ones.
     let injected = d(last.injected, first.injected);
     let over_weir = d(last.parked, first.parked) + injected
         - d(last.eroded, first.eroded)
-        - d(last.excluded, first.excluded);
+        - d(last.excluded, first.excluded)
+        - d(last.soaked, first.soaked);
     let to_m3_per_h = |n: f64| n * dp * dp * width / span * 3600.0;
     println!(
         "over the last {span:.0} s: inflow placed {:.3} m3/h, over the weir {:.3} m3/h \

@@ -268,6 +268,20 @@ fn print_summary(sim: &Simulation, last: &Observations, wall_s: f64) {
                 100.0 * f.blocked_share()
             ),
         ]);
+        if f.soaked_particles > 0 {
+            let share = if f.injected_particles > 0 {
+                format!(
+                    " ({:.1} % of those the inlet placed)",
+                    100.0 * f.soaked_particles as f64 / f.injected_particles as f64
+                )
+            } else {
+                String::new()
+            };
+            t.row([
+                "water in the bed's pores".to_string(),
+                format!("{} particles{share}", f.soaked_particles),
+            ]);
+        }
     }
     t.row([
         "blow-ups recovered".to_string(),

@@ -225,6 +225,24 @@ pub struct SedimentConfig {
     /// `h / c0`, so the sediment never shortens the time step below what the water needs.
     #[serde(default)]
     pub max_viscosity_pa_s: Option<f64>,
+    /// The dry bed's pores, which the water fills from above where it first covers the bed
+    /// (`simulation::pores`); without them the sand holds no water, as in the paper's model.
+    #[serde(default)]
+    pub pores: Option<BedPores>,
+}
+
+/// Pores of a sand bed laid dry, filled by Green & Ampt's (1911) infiltration
+/// (`physics::sediment::infiltration`).
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BedPores {
+    /// Volume of the pores over the bed's, 0-1: the water a dry bed takes, all of it
+    /// (the moisture deficit of a dry bed).
+    pub porosity: f64,
+    /// Saturated hydraulic conductivity K, m/s.
+    pub conductivity_m_per_s: f64,
+    /// Suction head at the wetting front psi_f, m.
+    pub suction_m: f64,
 }
 
 /// Yield criteria of a sediment phase (Zubeldia et al. 2018, Section 2.5).

@@ -3,7 +3,7 @@
 //! `crate::derived`, run after these by the loader.
 
 use super::{
-    Case, DensityDiffusion, Integrator, OpenFlume, PhaseConfig, SedimentConfig, Viscosity,
+    BedPores, Case, DensityDiffusion, Integrator, OpenFlume, PhaseConfig, SedimentConfig, Viscosity,
 };
 
 impl Case {
@@ -392,6 +392,32 @@ impl Case {
             && !positive(mu)
         {
             return err("max_viscosity_pa_s", "must be positive");
+        }
+        if let Some(pores) = &s.pores {
+            return self.validate_pores(i, pores);
+        }
+        Ok(())
+    }
+
+    fn validate_pores(&self, i: usize, p: &BedPores) -> Result<(), (String, String)> {
+        let err = |name: &str, reason: &str| {
+            Err((format!("phases[{i}].sediment.pores.{name}"), reason.into()))
+        };
+        if !(p.porosity.is_finite() && p.porosity > 0.0 && p.porosity < 1.0) {
+            return err("porosity", "must be between 0 and 1");
+        }
+        if !(p.conductivity_m_per_s.is_finite() && p.conductivity_m_per_s > 0.0) {
+            return err("conductivity_m_per_s", "must be positive");
+        }
+        if !(p.suction_m.is_finite() && p.suction_m >= 0.0) {
+            return err("suction_m", "must be >= 0");
+        }
+        if self.open_flume.is_none() {
+            // The water the pores take is parked, as the outlet's is.
+            return Err((
+                format!("phases[{i}].sediment.pores"),
+                "needs an open flume".into(),
+            ));
         }
         Ok(())
     }

@@ -150,6 +150,24 @@ pub struct StepState {
     pub excluded_log: [ExcludedParticle; EXCLUDED_LOG_LEN],
 }
 
+impl FlumeGpu {
+    /// Whether `x` lies in the inlet's buffer zone, where the inlet sets the velocity
+    /// (`flume.wgsl`'s `in_inlet`).
+    pub fn in_inlet(&self, x: &[f32; 4]) -> bool {
+        x[0] < self.inlet_x_face && x[1] > self.inlet_y_min && x[1] <= self.inlet_y_max
+    }
+
+    /// Where particle `id` waits while parked, with the parked phase (`store_rule.wgsl`).
+    pub fn parking_spot(&self, id: u32) -> [f32; 4] {
+        [
+            self.parking_x0 + (id % self.parking_cols) as f32 * self.parking_dp,
+            self.parking_y0 + (id / self.parking_cols) as f32 * self.parking_dp,
+            0.0,
+            f32::from_bits(self.parked_phase),
+        ]
+    }
+}
+
 impl StepState {
     /// The state at the start of a chunk that ends `t_target` seconds later, `run_steps` steps
     /// (wrapping) and `step_base` steps modulo the Verlet Euler period after the start of the

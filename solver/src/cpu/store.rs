@@ -52,11 +52,6 @@ impl<'a> Store<'a> {
         &self.phases[x[3].to_bits() as usize]
     }
 
-    /// Whether `x` lies in the inlet buffer zone.
-    fn in_inlet(f: &FlumeGpu, x: &[f32; 4]) -> bool {
-        x[0] < f.inlet_x_face && x[1] > f.inlet_y_min && x[1] <= f.inlet_y_max
-    }
-
     /// Whether the inlet carries `x` out at its velocity: water, or sediment, in its buffer.
     /// Sand the jet lifts from a bed under the orifice came to rest held in the opening, where
     /// the inlet places no particle over another: two grains held there from t = 50 s drained
@@ -65,7 +60,7 @@ impl<'a> Store<'a> {
     fn carried_by_inlet(&self, f: &FlumeGpu, x: &[f32; 4]) -> bool {
         let kind = x[3].to_bits();
         let sediment = self.params.sediment.phase;
-        (kind == f.water_phase || (sediment != 0 && kind == sediment)) && Self::in_inlet(f, x)
+        (kind == f.water_phase || (sediment != 0 && kind == sediment)) && f.in_inlet(x)
     }
 
     fn in_duct(f: &FlumeGpu, x: &[f32; 4]) -> bool {
@@ -239,12 +234,7 @@ impl<'a> Store<'a> {
 
     /// Parks particle `id` at its spot as water; eroded when it was sediment.
     fn park(&self, f: &FlumeGpu, id: u32, eroded: bool) -> (Particle, Event) {
-        let spot = [
-            f.parking_x0 + (id % f.parking_cols) as f32 * f.parking_dp,
-            f.parking_y0 + (id / f.parking_cols) as f32 * f.parking_dp,
-            0.0,
-            f32::from_bits(f.parked_phase),
-        ];
+        let spot = f.parking_spot(id);
         let rho = self.phases[f.parked_phase as usize].rho0;
         let event = Event {
             parked: true,

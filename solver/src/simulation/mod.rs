@@ -6,8 +6,10 @@
 
 mod chain;
 mod inflow;
+mod pores;
 
 pub use inflow::{InflowSchedule, RefusedInflow};
+pub use pores::PoreColumns;
 
 use crate::backend::Backend;
 use crate::config::{Case, Integrator, Viscosity, YieldCriterion};
@@ -57,6 +59,8 @@ pub struct Simulation {
     clean_chunks: u32,
     /// The open flume's host state; None for a closed tank.
     flume: Option<FlumeState>,
+    /// The dry bed's pores; None where the sand holds no water.
+    pores: Option<PoreColumns>,
     /// Time and eroded mass (kg/m) at the previous observation, for the erosion rate.
     last_eroded: std::cell::Cell<(f64, f64)>,
     /// Exclusions in one submission beyond which the run has blown up.
@@ -189,6 +193,7 @@ impl Simulation {
             )?),
         };
         let flume = FlumeState::new(case, &particles);
+        let pores = PoreColumns::new(case, &particles, &params.flume);
         let max_excluded = health::max_excluded_per_chunk(
             (0..particles.len())
                 .filter(|&i| !particles.is_wall(i))
@@ -210,6 +215,7 @@ impl Simulation {
             clean_chunks: 0,
             max_excluded,
             flume,
+            pores,
             last_eroded: std::cell::Cell::new((0.0, 0.0)),
             exclusion_log: ExclusionLog::default(),
         })
@@ -458,6 +464,7 @@ impl Simulation {
                 );
             }
             self.feed_inlet(advanced)?;
+            self.soak_pores(advanced)?;
         }
         Ok(())
     }
@@ -592,6 +599,7 @@ impl Simulation {
                 starved_particles: f.starved_particles,
                 blocked_particles: f.blocked_particles,
                 injected_particles: f.injected_particles,
+                soaked_particles: f.soaked_particles,
                 excluded_particles: f.excluded_particles,
                 excluded_sediment: f.excluded_sediment,
             });

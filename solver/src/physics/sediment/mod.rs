@@ -21,6 +21,7 @@
 
 pub mod drucker_prager;
 pub mod hold;
+pub mod infiltration;
 pub mod pass;
 pub mod pickup;
 pub mod rheology;
