@@ -260,6 +260,7 @@ fn a_cyclone_dds_peer_drives_the_twin_and_reads_the_solver_s_outputs() {
         "adapter",
         "stale_sensors",
         "inlet_blocked_spots",
+        "bed_pores_particles",
     ] {
         assert!(values.get(key).is_some(), "no {key} in {values}");
     }

@@ -169,6 +169,10 @@ impl Twin {
                 "inlet_blocked_spots",
                 flume.map_or(0, |f| f.blocked_particles).to_string(),
             ),
+            (
+                "bed_pores_particles",
+                flume.map_or(0, |f| f.soaked_particles).to_string(),
+            ),
             ("particle_frames_sent", c.frames_sent.to_string()),
             ("particle_frames_skipped", c.frames_skipped.to_string()),
         ];
