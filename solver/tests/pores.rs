@@ -119,3 +119,35 @@ fn the_gpu_backend_soaks_the_bed_as_the_cpu_backend_does() {
     let f = flume_of(&sim);
     assert_eq!(f.soaked_particles, N as u64);
 }
+
+/// A blow-up sends the state back to where the call began, and the pores go back with it:
+/// what they count parked is what the state holds parked, retries and all. (At CFL 5 the
+/// retries at 0.625 and 0.31 run several submissions, parking water, before one holds.)
+#[test]
+fn a_recovered_blow_up_takes_the_pores_back_with_the_state() {
+    let c = case();
+    let parked = flume_solver::particles::parked_phase(&c);
+    let mut sim = Simulation::new(Backend::cpu(2), &c).expect("case builds");
+    let start = sim.read_particles().expect("reads");
+    // Each column parks its second particle at F = 1.5 cm, about 1.1 s in.
+    sim.advance_to(1.0).expect("runs");
+    sim.set_cfl(5.0).expect("accepted for the test");
+    sim.advance_to(1.6).expect("recovers");
+    eprintln!("recoveries: {:?}", sim.recoveries());
+    assert!(!sim.recoveries().is_empty(), "CFL 5 did not blow up");
+    let in_pores: u32 = sim
+        .pores()
+        .expect("pores")
+        .columns()
+        .iter()
+        .map(|c| c.1)
+        .sum();
+    let now = sim.read_particles().expect("reads");
+    let f = flume_of(&sim);
+    assert_eq!(u64::from(in_pores), f.soaked_particles);
+    assert_eq!(
+        count(&now, parked) - count(&start, parked),
+        in_pores as usize,
+        "parked in the state"
+    );
+}

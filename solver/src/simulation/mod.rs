@@ -291,6 +291,7 @@ impl Simulation {
         }
         let saved = (self.time_s, self.steps, self.last_dt_s, self.dt_taken);
         let saved_flume = self.flume.clone();
+        let saved_pores = self.pores.clone();
         self.engine.save();
         let mut tries = 0;
         // When the first try failed, and whether every retry failed at about the same time:
@@ -335,6 +336,7 @@ impl Simulation {
             self.engine.restore();
             (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
             self.flume.clone_from(&saved_flume);
+            self.pores.clone_from(&saved_pores);
             self.params.cfl *= 0.5;
             self.engine.write_params(&self.params);
             log::warn!(
