@@ -30,6 +30,10 @@ struct Sediment {
     mu_max: f32,             // cap on the apparent viscosity, Pa s
     submerged_weight: f32,   // (rho_s - rho_w) |g|, N/m3 (Eq. 16 without theta and d)
     pickup_per_s: f32,       // van Rijn's pick-up rate per unit T^1.5, 1/s (0: Shields releases at once)
+    pickup_integrated: u32,  // 1: a held particle leaves once the rate's integral has taken its mass
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // The open flume (2-D); enabled == 0 for a closed tank.

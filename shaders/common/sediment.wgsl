@@ -20,6 +20,10 @@ const REGION_SUSPENDED: u32 = 4u;
 const REGION_WATER: u32 = 5u;
 // Set in a particle's region word when it is held fixed this step.
 const REGION_HELD: u32 = 256u;
+// Above the hold: the mass picked up of a held particle so far, in PICKUP_WHOLE-ths of it
+// (`PICKUP_SHIFT`, `PICKUP_WHOLE` of pickup.rs).
+const PICKUP_SHIFT: u32 = 9u;
+const PICKUP_WHOLE: u32 = 8388608u;
 
 // Eq. 17 (van Rijn 1993); "infinite" (HUGE) at Re* <= 0.
 fn critical_shields(re_star: f32) -> f32 {
@@ -257,6 +261,15 @@ fn pickup_rate(tau_b: f32, tau_bcr: f32) -> f32 {
 fn picked_up(id: u32, step: u32, rate: f32, dt: f32) -> bool {
     let chance = clamp(rate * dt, 0.0, 0.99999994);
     return pickup_draw(id, step) < u32(chance * 4294967296.0);
+}
+
+// The mass picked up of a held particle after a step of `dt` at `rate` per second, from `units`
+// before: PICKUP_WHOLE or more once none of it is left (`integrated_pickup` in pickup.rs; the
+// step's share rounded down or up by the particle's draw).
+fn integrated_pickup(units: u32, id: u32, step: u32, rate: f32, dt: f32) -> u32 {
+    let share = clamp(rate * dt, 0.0, 1.0) * f32(PICKUP_WHOLE);
+    let fraction = f32(pickup_draw(id, step) >> 8u) * (1.0 / 16777216.0);
+    return units + u32(share + fraction);
 }
 
 // A sediment particle's region (Figure 2 with the hold; `sediment_region` in pass.rs): in the

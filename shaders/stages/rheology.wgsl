@@ -94,6 +94,7 @@ fn deviatoric_strain(grad: mat3x3<f32>) -> mat3x3<f32> {
 struct Chosen {
     region: u32,
     mu: f32,
+    pickup: u32,   // the mass picked up of a held particle so far (pickup.rs)
 }
 
 // Sediment particle i's region and apparent viscosity from its sums, its density and II_D:
@@ -114,7 +115,8 @@ fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
     }
     let c_v = clamp(g.sediment_volume / g.mixture_volume, 0.0, 1.0);
     // Read before this thread writes it; no other thread writes this id's word.
-    let held_before = (regions[ids[i]] & REGION_HELD) != 0u;
+    let before = regions[ids[i]];
+    let held_before = (before & REGION_HELD) != 0u;
     // The stress the particle carries, which only the Drucker-Prager mode reads.
     var sqrt_j2 = 0.0;
     if (sd.shields_only == 0u) {
@@ -122,15 +124,26 @@ fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
     }
     // The pass before the step's size is chosen draws the pick-ups, one draw a step.
     var picked = sd.pickup_per_s == 0.0;
+    var pickup = select(before >> PICKUP_SHIFT, 0u, picked);
     if (!picked && BEFORE_DT) {
         let step = state.run_steps + state.steps;
-        picked = picked_up(ids[i], step, pickup_rate(tau_b, tau_bcr), state.dt_taken);
+        let rate = pickup_rate(tau_b, tau_bcr);
+        if (sd.pickup_integrated != 0u) {
+            let worn = integrated_pickup(pickup, ids[i], step, rate, state.dt_taken);
+            picked = worn >= PICKUP_WHOLE;
+            pickup = select(worn, 0u, picked);
+        } else {
+            picked = picked_up(ids[i], step, rate, state.dt_taken);
+            pickup = 0u;
+        }
     }
     let region = sediment_region(RegionInputs(
         sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
         picked
     ));
-    return Chosen(region, region_viscosity(region, ii_d, tau_y, tau_bcr, c_v));
+    // What was worn off a particle stays with it while it is held, and only then.
+    let kept = select(0u, pickup, region == REGION_UNYIELDED && held_before);
+    return Chosen(region, region_viscosity(region, ii_d, tau_y, tau_bcr, c_v), kept);
 }
 
 @compute @workgroup_size(64)
@@ -174,19 +187,22 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Water's own viscosity and its eddy viscosity; sediment takes its region's below.
     var mu = ph_i.mu + sps_viscosity(rho_i, ii_d);
     var region = REGION_WATER;
+    var pickup = 0u;
     if (is_sediment) {
         let chosen = sediment_rheology(i, rho_i, g, ii_d);
         region = chosen.region;
         mu = chosen.mu;
+        pickup = chosen.pickup;
     }
     // Shields-only holds carry no stress; Drucker-Prager holds keep theirs (hold.rs).
     let held = region == REGION_UNYIELDED;
     let t = select(2.0 * mu, 0.0, held && sd.shields_only != 0u) * eps;
     let word = region | select(0u, REGION_HELD, held);
     textureStore(stress_a, texel(i), vec4<f32>(t[0].x, t[1].x, t[2].x, t[1].y));
-    // The whole region word: the hold stage reads which neighbours this pass held.
+    // The region and the hold, exact in an f32: the hold stage reads which neighbours this
+    // pass held.
     textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(word)));
     // By particle id: the integrators, the probes and the host each see the particles in a
     // different order.
-    regions[ids[i]] = word;
+    regions[ids[i]] = word | (pickup << PICKUP_SHIFT);
 }

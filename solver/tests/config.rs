@@ -477,6 +477,35 @@ fn the_case_and_the_uniform_agree_on_a_held_bed_standing_as_a_wall() {
 }
 
 #[test]
+fn the_erosion_reaches_both_backends_and_a_wrong_one_is_named() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+    for (erosion, rate, integrated) in [
+        ("threshold", false, 0),
+        ("van_rijn_pickup", true, 0),
+        ("van_rijn_integrated", true, 1),
+    ] {
+        let set = [
+            format!("phases.1.sediment.erosion={erosion}"),
+            "numerics.dp_m=0.02".to_string(),
+        ];
+        let case = Case::from_path_with(&path, &set).unwrap_or_else(|e| panic!("{e}"));
+        let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &case)
+            .unwrap_or_else(|e| panic!("{erosion}: {e}"));
+        let block = sim.params().sediment;
+        assert_eq!(block.pickup_per_s > 0.0, rate, "{erosion}");
+        assert_eq!(block.pickup_integrated, integrated, "{erosion}");
+        let model = flume_solver::contract::sediment_model(&case, sim.derived()).expect("sand");
+        assert_eq!(model.pickup_integrated, integrated == 1, "{erosion}");
+    }
+    let (f, r) = refused(&ULBRA.replace(
+        "      criterion: shields_only\n",
+        "      criterion: shields_only\n      erosion: van_rijn_worn\n",
+    ));
+    assert!(f.starts_with("phases"), "{f}: {r}");
+    assert!(r.contains("van_rijn_integrated"), "{f}: {r}");
+}
+
+#[test]
 fn the_shields_speed_reaches_both_backends_and_a_wrong_one_is_named() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
     for (set, want) in [

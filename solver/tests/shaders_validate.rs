@@ -131,7 +131,7 @@ fn wgsl_constant(stage: &str, name: &str) -> naga::Literal {
 #[test]
 fn every_constant_stated_on_both_sides_agrees() {
     use flume_solver::contract as c;
-    use flume_solver::physics::sediment::{hold, pass, rheology, shields, suspension};
+    use flume_solver::physics::sediment::{hold, pass, pickup, rheology, shields, suspension};
     use flume_solver::{Health, Region};
     use naga::Literal::{F32, U32};
     let region = |r: Region| U32(r as u32);
@@ -210,6 +210,8 @@ fn every_constant_stated_on_both_sides_agrees() {
         ("rheology", "REGION_SUSPENDED", region(Region::Suspended)),
         ("rheology", "REGION_WATER", region(Region::Water)),
         ("rheology", "REGION_HELD", U32(pass::REGION_HELD)),
+        ("rheology", "PICKUP_SHIFT", U32(pickup::PICKUP_SHIFT)),
+        ("rheology", "PICKUP_WHOLE", U32(pickup::PICKUP_WHOLE)),
         (
             "symplectic_predictor",
             "REGION_HELD_BIT",

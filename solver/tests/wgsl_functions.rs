@@ -19,14 +19,16 @@
 mod common;
 
 use common::gpu_lock;
-use common::probe::{Input, VULKAN_DIVISION, probe, same};
+use common::probe::{Input, Probe, VULKAN_DIVISION, probe, same};
 use flume_solver::Region;
 use flume_solver::physics::eos;
 use flume_solver::physics::eos::pressure;
 use flume_solver::physics::kernel::Wendland;
 use flume_solver::physics::sediment::drucker_prager::{alpha, kappa_c, yield_stress};
 use flume_solver::physics::sediment::pass::{skeleton_pressure, slope_factors};
-use flume_solver::physics::sediment::pickup::{picked_up, pickup_draw, pickup_rate};
+use flume_solver::physics::sediment::pickup::{
+    PICKUP_WHOLE, integrated_pickup, picked_up, pickup_draw, pickup_rate,
+};
 use flume_solver::physics::sediment::rheology::hbp_viscosity;
 use flume_solver::physics::sediment::shields::{critical_shields, friction_velocity};
 use flume_solver::physics::sediment::suspension::{
@@ -393,6 +395,62 @@ fn the_pickup() {
     assert!(
         picked > chances.len() / 4 && picked < chances.len() * 3 / 4,
         "{picked}"
+    );
+    worn_away_alike(&p, &pairs, halves);
+}
+
+/// `integrated_pickup` of both sides, to the unit: shares of a step from none through a
+/// fraction of a unit (rounded by the draw) to a whole particle, from nothing worn to one unit
+/// short of the whole.
+fn worn_away_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]) {
+    let mut cases = Vec::new();
+    for &(id, step) in pairs {
+        for units in [0u32, 1, 4_194_304, PICKUP_WHOLE - 1] {
+            for share in [0.0f32, 0.3 / PICKUP_WHOLE as f32, 2.7e-6, 0.25, 1.0, 3.0] {
+                let [i1, i0] = halves(id);
+                let [s1, s0] = halves(step);
+                let [u1, u0] = halves(units);
+                cases.push([[i1, i0, s1, s0], [share, 1.0, u1, u0]]);
+            }
+        }
+    }
+    let helper = "fn worn_probe(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    let id = (u32(a.x) << 16u) | u32(a.y);
+    let units = (u32(b.z) << 16u) | u32(b.w);
+    let w = integrated_pickup(units, id, (u32(a.z) << 16u) | u32(a.w), b.x, b.y);
+    return vec4<f32>(f32(w >> 16u), f32(w & 0xffffu), 0.0, 0.0);
+}
+";
+    let got = p.run_with(helper, "worn_probe(a, b)", &cases);
+    let (mut rounded_up, mut rounded_down) = (0, 0);
+    for (i, got) in cases.iter().zip(&got) {
+        let id = ((i[0][0] as u32) << 16) | i[0][1] as u32;
+        let step = ((i[0][2] as u32) << 16) | i[0][3] as u32;
+        let units = ((i[1][2] as u32) << 16) | i[1][3] as u32;
+        let got = ((got[0] as u32) << 16) | got[1] as u32;
+        let want = integrated_pickup(units, id, step, i[1][0], i[1][1]);
+        assert_eq!(
+            got < PICKUP_WHOLE,
+            want.is_some(),
+            "worn away: id {id}, step {step}, units {units}, share {}",
+            i[1][0]
+        );
+        if let Some(want) = want {
+            assert_eq!(
+                got, want,
+                "id {id}, step {step}, units {units}, share {}",
+                i[1][0]
+            );
+        }
+        if i[1][0] == 0.3 / PICKUP_WHOLE as f32 && units == 0 {
+            rounded_up += usize::from(got == 1);
+            rounded_down += usize::from(got == 0);
+        }
+    }
+    // Not vacuous: a share of 0.3 units is rounded both ways.
+    assert!(
+        rounded_up > 0 && rounded_down > 0,
+        "{rounded_up} / {rounded_down}"
     );
 }
 

@@ -93,8 +93,9 @@ pub fn printed(out: &std::process::Output) -> String {
 /// (`scripts/run.sh`): the arguments after the case file. At this dp the flow is two to four
 /// particles deep, and the paper's choices (DBC walls, alpha = 0.02, the release at once) hold
 /// the water 2-3 cm too high and rising; the twin takes the generalised walls, the flow's eddy
-/// viscosity at 2 m3/h and van Rijn's pick-up (README, levels section).
-pub const ULBRA_CI: [&str; 10] = [
+/// viscosity at 2 m3/h, van Rijn's pick-up worn away and the Shields test on the water's own
+/// speed (README, levels section).
+pub const ULBRA_CI: [&str; 12] = [
     "--set",
     "numerics.dp_m=0.01",
     "--set",
@@ -104,7 +105,9 @@ pub const ULBRA_CI: [&str; 10] = [
     "--set",
     "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
     "--set",
-    "phases.1.sediment.erosion=van_rijn_pickup",
+    "phases.1.sediment.erosion=van_rijn_integrated",
+    "--set",
+    "phases.1.sediment.shields_speed=water",
 ];
 
 /// `flume-twin run` on the CI-size ULBRA flume from the repository's root (where the bundled

@@ -266,6 +266,12 @@ pub enum Erosion {
     /// At van Rijn's (1984) pick-up rate: a particle is released in a step with the chance that
     /// the flow picks up its mass from its share of the bed (`physics::sediment::pickup`).
     VanRijnPickup,
+    /// At van Rijn's (1984) pick-up rate, worn away: a particle is released once the rate,
+    /// integrated over the steps it is held, has taken its whole mass
+    /// (`physics::sediment::pickup::integrated_pickup`). A front that passes in a second
+    /// wears a fraction of a particle off, as it takes a fraction of a millimetre off the real
+    /// bed, where a chance each step lifts a whole particle here and there.
+    VanRijnIntegrated,
 }
 
 /// The u of the log law (Eqs. 19-21) that the Shields test reads from the nearest water

@@ -40,6 +40,8 @@ pub struct SedimentGpu {
     pub mu_max: f32,
     pub submerged_weight: f32,
     pub pickup_per_s: f32,
+    pub pickup_integrated: u32,
+    pub pad: [u32; 3],
 }
 
 /// `Flume` of `shaders/common/params.wgsl` (units there).

@@ -218,7 +218,7 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
         submerged_weight: ((rho_s - rho_w) * case.gravity_magnitude()) as f32,
         pickup_per_s: match cfg.erosion {
             Erosion::Threshold => 0.0,
-            Erosion::VanRijnPickup => pickup_per_s(
+            Erosion::VanRijnPickup | Erosion::VanRijnIntegrated => pickup_per_s(
                 cfg.d50_m,
                 rho_s,
                 rho_w,
@@ -227,6 +227,8 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
                 case.numerics.dp_m,
             ) as f32,
         },
+        pickup_integrated: u32::from(cfg.erosion == Erosion::VanRijnIntegrated),
+        pad: [0; 3],
     }
 }
 
@@ -259,5 +261,6 @@ pub fn sediment_model(case: &Case, derived: &Derived) -> Option<SedimentModel> {
         water_speed: cfg.shields_speed == ShieldsSpeed::Water,
         mu_max: block.mu_max,
         pickup_per_s: block.pickup_per_s,
+        pickup_integrated: block.pickup_integrated != 0,
     })
 }

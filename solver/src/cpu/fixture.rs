@@ -72,6 +72,7 @@ fn sediment() -> SedimentModel {
         water_speed: false,
         mu_max: 50.0,
         pickup_per_s: 0.0,
+        pickup_integrated: false,
     }
 }
 

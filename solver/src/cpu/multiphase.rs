@@ -20,15 +20,16 @@ use crate::physics::interaction::phase_index;
 use crate::physics::lanes::{LANES, Lanes};
 use crate::physics::sediment::hold::{Release, Transmitted};
 use crate::physics::sediment::pass::{
-    Draws, ParticleRheology, Rheology, RheologySide, RheologySums, SedimentModel,
+    Draws, ParticleRheology, REGION_HELD, Rheology, RheologySide, RheologySums, SedimentModel,
 };
 use crate::physics::sediment::suspension::Region;
 use rayon::prelude::*;
 
 /// The held sediment of the last pass and the pick-up draws of this one.
 pub struct Holds<'a> {
-    /// Whether each active particle (sorted order) was held after the last pass.
-    pub before: &'a [bool],
+    /// Each active particle's region word after the last pass (sorted order): whether it was
+    /// held, and the mass picked up of it so far.
+    pub words: &'a [u32],
     /// The particles' ids (sorted order): their draws'.
     pub ids: &'a [u32],
     pub draws: Option<Draws>,
@@ -57,12 +58,12 @@ pub fn rheology_pass(
     holds: &Holds,
     release: bool,
 ) -> RheologyPass {
-    let held_before = holds.before;
+    let held_before = |i: usize| holds.words[i] & REGION_HELD != 0;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
-    let n = held_before.len();
+    let n = holds.words.len();
     let stirrers = holds
         .awake_set
-        .then(|| stirring(params, (pos, vel), held_before));
+        .then(|| stirring(params, (pos, vel), holds.words));
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
     let (vol, (sides, asleep)): (Vec<f32>, (Vec<RheologySide>, Vec<bool>)) = pool.install(|| {
@@ -70,7 +71,7 @@ pub fn rheology_pass(
             .into_par_iter()
             .map(|i| {
                 let side = pass.side(&pos[i], &vel[i]);
-                let sleeps = held_before[i]
+                let sleeps = held_before(i)
                     && stirrers
                         .as_ref()
                         .is_some_and(|s| !grid.any_near(s, &side.x));
@@ -87,6 +88,7 @@ pub fn rheology_pass(
         vol: &vol,
         sides: &sides,
         ids: holds.ids,
+        words: holds.words,
         asleep: &asleep,
     };
     // Every slot is written by its block.
@@ -95,6 +97,7 @@ pub fn rheology_pass(
         mu: 0.0,
         region: 0,
         held: false,
+        pickup: 0,
     };
     let mut out = vec![none; n];
     let asleep = pool.install(|| {
@@ -103,7 +106,7 @@ pub fn rheology_pass(
             .map(|(b, out)| {
                 simd::dispatch(
                     #[inline(always)]
-                    || pairs.block(b * BLOCK, out, held_before),
+                    || pairs.block(b * BLOCK, out),
                 )
             })
             .sum()
@@ -144,21 +147,19 @@ fn release_held(
     for (r, _) in out.iter_mut().zip(released).filter(|(_, go)| *go) {
         r.held = false;
         r.region = Region::Yielded as u32;
+        r.pickup = 0;
     }
 }
 
 /// The particles that stir a held grain's neighbourhood: any but held grains and walls at
 /// rest. A held grain with none of them in the cells within reach sleeps (see the module doc).
-fn stirring(
-    params: &Params,
-    (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
-    held_before: &[bool],
-) -> Flagged {
+fn stirring(params: &Params, (pos, vel): (&[[f32; 4]], &[[f32; 4]]), words: &[u32]) -> Flagged {
     let rests = |k: usize| {
         let still = vel[k][..3].iter().all(|&v| v == 0.0);
-        still && (held_before[k] || !params.phases[phase_index(&pos[k])].mobile)
+        let held = words[k] & REGION_HELD != 0;
+        still && (held || !params.phases[phase_index(&pos[k])].mobile)
     };
-    Flagged::new(held_before.len(), |k| !rests(k))
+    Flagged::new(words.len(), |k| !rests(k))
 }
 
 /// Particles per block handed to a thread, as in the force pass.
@@ -174,6 +175,8 @@ struct Pairs<'a> {
     vol: &'a [f32],
     sides: &'a [RheologySide],
     ids: &'a [u32],
+    /// The region words of the last pass.
+    words: &'a [u32],
     /// The grains that may sleep in this pass.
     asleep: &'a [bool],
 }
@@ -183,7 +186,7 @@ impl Pairs<'_> {
     /// as the force pass takes them: each lane sums its own neighbours in sorted order.
     /// Returns how many were spared the walk over their neighbours.
     #[inline(always)]
-    fn block(&self, first: usize, out: &mut [ParticleRheology], held_before: &[bool]) -> usize {
+    fn block(&self, first: usize, out: &mut [ParticleRheology]) -> usize {
         let mut asleep = 0;
         let (pass, grid, pos, vel) = (self.pass, self.grid, self.pos, self.vel);
         let end = first + out.len();
@@ -199,15 +202,15 @@ impl Pairs<'_> {
                 asleep += group.range.len();
                 for i in group.range.clone() {
                     let s = pass.start(&pos[i], &vel[i]);
-                    let held = held_before[i];
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, held, self.ids[i]);
+                    let before = self.words[i];
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, self.ids[i]);
                 }
             } else {
                 let sums = self.group(&group);
                 for (lane, i) in group.range.clone().enumerate() {
                     let s = sums.lane(lane);
-                    let held = held_before[i];
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, held, self.ids[i]);
+                    let before = self.words[i];
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, self.ids[i]);
                 }
             }
             start = group.range.end;
@@ -262,12 +265,14 @@ mod tests {
             .build()
             .expect("a pool of two threads");
         let n = fx.pos.len();
-        let held: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
+        let held: Vec<u32> = (0..n)
+            .map(|i| if i % 3 == 0 { REGION_HELD } else { 0 })
+            .collect();
         let ids: Vec<u32> = (0..n as u32).collect();
         let (params, grid) = (&fx.params, &fx.grid);
         let pass_with = |awake_set| {
             let holds = Holds {
-                before: &held,
+                words: &held,
                 ids: &ids,
                 draws: None,
                 awake_set,

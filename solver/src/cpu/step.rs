@@ -30,13 +30,19 @@ impl CpuEngine {
 
     /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
     fn holds(&self, b: &State) -> Vec<bool> {
+        self.words(b).iter().map(|w| w & REGION_HELD != 0).collect()
+    }
+
+    /// The region word the last rheology pass left each mobile particle of `b` (sorted
+    /// order); 0 for the others.
+    fn words(&self, b: &State) -> Vec<u32> {
         let phases = &self.model.phases;
         b.positions
             .iter()
             .zip(&b.ids)
             .map(|(x, &id)| {
-                phases[x[3].to_bits() as usize].mobile
-                    && self.regions[id as usize] & REGION_HELD != 0
+                let mobile = phases[x[3].to_bits() as usize].mobile;
+                if mobile { self.regions[id as usize] } else { 0 }
             })
             .collect()
     }
@@ -134,9 +140,9 @@ impl CpuEngine {
     ) -> Option<Vec<ParticleRheology>> {
         let active = grid.active() as usize;
         let model = self.sediment.as_ref()?;
-        let held = self.holds(b);
+        let words = self.words(b);
         let holds = Holds {
-            before: &held[..active],
+            words: &words[..active],
             ids: &b.ids[..active],
             draws,
             awake_set: self.awake_set,

@@ -178,7 +178,8 @@ pub fn reference_sediment(
         mu_max: mu_max as f32,
         pickup_per_s: match cfg.erosion {
             flume_solver::config::Erosion::Threshold => 0.0,
-            flume_solver::config::Erosion::VanRijnPickup => {
+            flume_solver::config::Erosion::VanRijnPickup
+            | flume_solver::config::Erosion::VanRijnIntegrated => {
                 flume_solver::physics::sediment::pickup::pickup_per_s(
                     cfg.d50_m,
                     sed.rho0_kg_per_m3,
@@ -189,6 +190,7 @@ pub fn reference_sediment(
                 ) as f32
             }
         },
+        pickup_integrated: cfg.erosion == flume_solver::config::Erosion::VanRijnIntegrated,
     }
 }
 

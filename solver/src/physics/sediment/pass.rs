@@ -19,7 +19,7 @@
 
 use super::SedimentParams;
 use super::drucker_prager::{alpha, kappa_c, yield_stress};
-use super::pickup::{picked_up, pickup_rate};
+use super::pickup::{PICKUP_SHIFT, integrated_pickup, picked_up, pickup_rate};
 use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
     bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity, k_beta,
@@ -56,6 +56,9 @@ pub struct SedimentModel {
     /// van Rijn's pick-up rate per unit `T^1.5`, 1/s ([`super::pickup`]); 0: Shields releases a
     /// particle at once, as the paper does.
     pub pickup_per_s: f32,
+    /// A held particle leaves once the pick-up rate's integral has taken its mass
+    /// ([`super::pickup::integrated_pickup`]), not by a chance each step.
+    pub pickup_integrated: bool,
 }
 
 /// The pick-up draw of a rheology pass: the run's step count (wrapping) and the last step's
@@ -78,6 +81,9 @@ pub struct ParticleRheology {
     pub region: u32,
     /// Held fixed this step: un-yielded sediment (region 1).
     pub held: bool,
+    /// The share of a held particle's mass the flow has picked up so far, in
+    /// [`PICKUP_WHOLE`](super::pickup::PICKUP_WHOLE)ths (`van_rijn_integrated`; 0 otherwise).
+    pub pickup: u32,
 }
 
 /// Bit of a region word marking sediment held fixed; `REGION_HELD` of
@@ -85,9 +91,10 @@ pub struct ParticleRheology {
 pub const REGION_HELD: u32 = 256;
 
 impl ParticleRheology {
-    /// The region word the backends store per particle: the region, and `REGION_HELD`.
+    /// The region word the backends store per particle: the region, `REGION_HELD`, and above
+    /// them the mass picked up so far.
     pub fn word(&self) -> u32 {
-        self.region | if self.held { REGION_HELD } else { 0 }
+        self.region | if self.held { REGION_HELD } else { 0 } | self.pickup << PICKUP_SHIFT
     }
 }
 
@@ -410,14 +417,15 @@ impl<'a> Rheology<'a> {
         }
     }
 
-    /// Particle i's rheology from its sums, `held_before` whether it was held after the
-    /// previous pass (see [`rheology_pass`]), `id` its id (its pick-up draw's).
+    /// Particle i's rheology from its sums, `before` its region word after the previous pass
+    /// (whether it was held, and what of it was picked up; see [`rheology_pass`]), `id` its
+    /// id (its pick-up draw's).
     pub fn finish(
         &self,
         x_i: &[f32; 4],
         v_i: &[f32; 4],
         s: &RheologySums,
-        held_before: bool,
+        before: u32,
         id: u32,
     ) -> ParticleRheology {
         let params = self.params;
@@ -428,15 +436,16 @@ impl<'a> Rheology<'a> {
                 mu: 0.0,
                 region: 0,
                 held: false,
+                pickup: 0,
             };
         }
         let eps = strain_rate(&s.grad, params.dim);
         let ii_d = second_invariant(&eps);
-        let (region, mu, held) = if self.is_sediment(x_i) {
-            self.classify(v_i[3], s, ii_d, (held_before, id))
+        let (region, mu, held, pickup) = if self.is_sediment(x_i) {
+            self.classify(v_i[3], s, ii_d, (before, id))
         } else {
             let eddy = sps_viscosity(v_i[3], self.sps_length2, ii_d);
-            (Region::Water as u32, phase_i.mu + eddy, false)
+            (Region::Water as u32, phase_i.mu + eddy, false, 0)
         };
         let mut stress = [[0.0_f32; 3]; 3];
         // Shields-only holds carry no stress, as that mode always had; Drucker-Prager holds
@@ -453,6 +462,7 @@ impl<'a> Rheology<'a> {
             mu,
             region,
             held,
+            pickup,
         }
     }
 
@@ -485,15 +495,16 @@ impl<'a> Rheology<'a> {
         chain
     }
 
-    /// Region, apparent viscosity and hold of a sediment particle of density `rho_i`, held
-    /// before or not, of id `id`.
+    /// Region, apparent viscosity, hold and mass picked up of a sediment particle of density
+    /// `rho_i`, of region word `before` after the last pass, of id `id`.
     fn classify(
         &self,
         rho_i: f32,
         s: &RheologySums,
         ii_d: f32,
-        (held_before, id): (bool, u32),
-    ) -> (u32, f32, bool) {
+        (before, id): (u32, u32),
+    ) -> (u32, f32, bool, u32) {
+        let held_before = before & REGION_HELD != 0;
         let (model, mat) = (self.model, &self.model.material);
         let sed = &self.params.phases[model.sediment_phase];
         let p = pressure(rho_i, sed.rho0, self.b_sed);
@@ -509,6 +520,7 @@ impl<'a> Rheology<'a> {
             ..
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
+        let (picked_up, pickup) = self.pick_up(before >> PICKUP_SHIFT, id, tau_b, tau_bcr);
         // The stress the particle carries, which only the Drucker-Prager mode reads.
         let sqrt_j2 = if model.shields_only {
             0.0
@@ -525,28 +537,38 @@ impl<'a> Rheology<'a> {
             sqrt_j2,
             tau_y,
             c_v,
-            picked_up: self.picked_up(id, tau_b, tau_bcr),
+            picked_up,
         });
         let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
-        (
-            region as u32,
-            mu.min(model.mu_max),
-            region == Region::Unyielded,
-        )
+        let held = region == Region::Unyielded;
+        // What was worn off a particle stays with it while it is held, and only then.
+        let pickup = if held && held_before { pickup } else { 0 };
+        (region as u32, mu.min(model.mu_max), held, pickup)
     }
 }
 
 impl Rheology<'_> {
     /// Whether particle `id`, under a bed shear stress `tau_b` against its critical `tau_bcr`,
-    /// is picked up in this pass: always where Shields releases at once, never in a pass
-    /// without draws.
-    fn picked_up(&self, id: u32, tau_b: f32, tau_bcr: f32) -> bool {
+    /// is picked up in this pass, with the mass picked up of it after the pass (`units` before;
+    /// `van_rijn_integrated`): picked up always where Shields releases at once, never in a
+    /// pass without draws.
+    fn pick_up(&self, units: u32, id: u32, tau_b: f32, tau_bcr: f32) -> (bool, u32) {
         let per_s = self.model.pickup_per_s;
         if per_s == 0.0 {
-            return true;
+            return (true, 0);
         }
-        self.draws
-            .is_some_and(|d| picked_up(id, d.step, pickup_rate(per_s, tau_b, tau_bcr), d.dt_s))
+        let Some(d) = self.draws else {
+            return (false, units);
+        };
+        let rate = pickup_rate(per_s, tau_b, tau_bcr);
+        if self.model.pickup_integrated {
+            match integrated_pickup(units, id, d.step, rate, d.dt_s) {
+                Some(units) => (false, units),
+                None => (true, 0),
+            }
+        } else {
+            (picked_up(id, d.step, rate, d.dt_s), 0)
+        }
     }
 }
 
@@ -573,7 +595,8 @@ pub fn rheology_pass(
             for j in 0..pos.len() {
                 pass.add_pair((&pos[i], &vel_rho[i]), (&pos[j], &vel_rho[j]), &mut s);
             }
-            pass.finish(&pos[i], &vel_rho[i], &s, held_before[i], i as u32)
+            let before = if held_before[i] { REGION_HELD } else { 0 };
+            pass.finish(&pos[i], &vel_rho[i], &s, before, i as u32)
         })
         .collect()
 }

@@ -60,6 +60,28 @@ pub fn picked_up(id: u32, step: u32, rate: f32, dt_s: f32) -> bool {
 /// The largest chance of a step, just under 1, whose share of the 32-bit range is a u32.
 const LARGEST_CHANCE: f32 = 0.999_999_94;
 
+/// Where a held particle's mass picked up so far sits in its region word: above the region's
+/// byte and `REGION_HELD`, in units of [`PICKUP_WHOLE`]ths of the particle.
+pub const PICKUP_SHIFT: u32 = 9;
+
+/// The units of a whole particle's mass: 2^23, all the bits of the word above the hold.
+pub const PICKUP_WHOLE: u32 = 1 << 23;
+
+/// The mass a held particle has lost to the flow after a step of `dt_s` at `rate` per second
+/// (`van_rijn_integrated`), from the `units` lost before: None once it reaches the whole
+/// particle, which the flow then carries off. A particle far larger than a grain is not lifted
+/// whole by a chance: its layer of grains is worn away at the rate, as the Exner equation
+/// lowers a bed, and it leaves when nothing of it is left. A step's share, often under one
+/// unit, is rounded down or up by particle `id`'s draw at run step `step`, with the chance of
+/// its fraction, so that no share is lost to the rounding on average.
+pub fn integrated_pickup(units: u32, id: u32, step: u32, rate: f32, dt_s: f32) -> Option<u32> {
+    let share = (rate * dt_s).clamp(0.0, 1.0) * PICKUP_WHOLE as f32;
+    // The draw's top 24 bits, exact in f32: a uniform fraction in [0, 1).
+    let fraction = (pickup_draw(id, step) >> 8) as f32 * (1.0 / 16_777_216.0);
+    let total = units.saturating_add((share + fraction) as u32);
+    (total < PICKUP_WHOLE).then_some(total)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,6 +119,44 @@ mod tests {
         assert_eq!(pickup_draw(0, 0), 817_759_070);
         assert_ne!(pickup_draw(1, 0), pickup_draw(0, 0));
         assert_ne!(pickup_draw(0, 1), pickup_draw(0, 0));
+    }
+
+    /// A particle worn at a constant rate leaves once the rate's integral reaches its mass:
+    /// at 0.5 per second and steps of 1e-3 s, each step takes 2^22 / 1000 = 4194.304 units,
+    /// 4,194 or 4,195 after the draw's rounding. After 1,999 steps at most 1,999 x 4,195 =
+    /// 8,385,805 are gone, under the whole 2^23 = 8,388,608; after 2,001 at least 2,001 x 4,194
+    /// = 8,392,194.
+    #[test]
+    fn a_particle_worn_at_a_constant_rate_leaves_when_its_mass_is_gone() {
+        let mut units = 0;
+        let mut left = None;
+        for step in 1..=3000u32 {
+            match integrated_pickup(units, 7, step, 0.5, 1e-3) {
+                Some(u) => units = u,
+                None => {
+                    left = Some(step);
+                    break;
+                }
+            }
+        }
+        let left = left.expect("worn away");
+        assert!((2000..=2001).contains(&left), "left at step {left}");
+        // Nothing is taken without a rate, and a step's whole share takes it at once.
+        assert_eq!(integrated_pickup(5, 7, 1, 0.0, 1e-3), Some(5));
+        assert_eq!(integrated_pickup(0, 7, 1, 2.0, 1.0), None);
+    }
+
+    /// A share far under one unit a step is not lost to the rounding: 1e5 steps of 0.25 units
+    /// take 25,000 +/- 3 sigma (sqrt(1e5 x 0.25 x 0.75) = 137, so 411) units, and none without
+    /// the draw's help would be taken at all.
+    #[test]
+    fn shares_under_a_unit_add_up_on_average() {
+        let rate = 0.25 / PICKUP_WHOLE as f32;
+        let mut units = 0;
+        for step in 0..100_000u32 {
+            units = integrated_pickup(units, 11, step, rate, 1.0).expect("far from whole");
+        }
+        assert!((24_589..=25_411).contains(&units), "{units}");
     }
 
     /// Over many steps a particle is picked up as often as its rate says: 1e5 steps at a

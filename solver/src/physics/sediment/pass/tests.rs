@@ -94,6 +94,7 @@ fn flume_case() -> (Params, SedimentModel) {
         water_speed: false,
         mu_max: 50.0,
         pickup_per_s: 0.0,
+        pickup_integrated: false,
     };
     (params, model)
 }
