@@ -476,25 +476,35 @@ fn the_case_and_the_uniform_agree_on_a_held_bed_standing_as_a_wall() {
     }
 }
 
+/// The bundled flume at dp = 2 cm with `set`, built on the CPU backend, and the CPU
+/// backend's sediment model of it.
+fn flume_with(
+    set: &[&str],
+) -> (
+    flume_solver::Simulation,
+    flume_solver::physics::sediment::pass::SedimentModel,
+) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+    let mut set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    set.push("numerics.dp_m=0.02".to_string());
+    let case = Case::from_path_with(&path, &set).unwrap_or_else(|e| panic!("{e}"));
+    let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &case)
+        .unwrap_or_else(|e| panic!("{set:?}: {e}"));
+    let model = flume_solver::contract::sediment_model(&case, sim.derived()).expect("sand");
+    (sim, model)
+}
+
 #[test]
 fn the_erosion_reaches_both_backends_and_a_wrong_one_is_named() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
     for (erosion, rate, integrated) in [
         ("threshold", false, 0),
         ("van_rijn_pickup", true, 0),
         ("van_rijn_integrated", true, 1),
     ] {
-        let set = [
-            format!("phases.1.sediment.erosion={erosion}"),
-            "numerics.dp_m=0.02".to_string(),
-        ];
-        let case = Case::from_path_with(&path, &set).unwrap_or_else(|e| panic!("{e}"));
-        let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &case)
-            .unwrap_or_else(|e| panic!("{erosion}: {e}"));
+        let (sim, model) = flume_with(&[&format!("phases.1.sediment.erosion={erosion}")]);
         let block = sim.params().sediment;
         assert_eq!(block.pickup_per_s > 0.0, rate, "{erosion}");
         assert_eq!(block.pickup_integrated, integrated, "{erosion}");
-        let model = flume_solver::contract::sediment_model(&case, sim.derived()).expect("sand");
         assert_eq!(model.pickup_integrated, integrated == 1, "{erosion}");
     }
     let (f, r) = refused(&ULBRA.replace(
@@ -507,19 +517,13 @@ fn the_erosion_reaches_both_backends_and_a_wrong_one_is_named() {
 
 #[test]
 fn the_shields_speed_reaches_both_backends_and_a_wrong_one_is_named() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
     for (set, want) in [
         (vec![], 0),
         (vec!["phases.1.sediment.shields_speed=relative_to_grain"], 0),
         (vec!["phases.1.sediment.shields_speed=water"], 1),
     ] {
-        let mut set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
-        set.push("numerics.dp_m=0.02".to_string());
-        let case = Case::from_path_with(&path, &set).unwrap_or_else(|e| panic!("{e}"));
-        let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &case)
-            .unwrap_or_else(|e| panic!("{set:?}: {e}"));
+        let (sim, model) = flume_with(&set);
         assert_eq!(sim.params().sediment.water_speed, want, "{set:?}");
-        let model = flume_solver::contract::sediment_model(&case, sim.derived()).expect("sand");
         assert_eq!(model.water_speed, want == 1, "{set:?}");
     }
     let (f, r) = refused(&ULBRA.replace(

@@ -30,21 +30,24 @@ impl CpuEngine {
 
     /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
     fn holds(&self, b: &State) -> Vec<bool> {
-        self.words(b).iter().map(|w| w & REGION_HELD != 0).collect()
+        let words = b.positions.iter().zip(&b.ids);
+        words
+            .map(|(x, &id)| self.word(x, id) & REGION_HELD != 0)
+            .collect()
     }
 
     /// The region word the last rheology pass left each mobile particle of `b` (sorted
     /// order); 0 for the others.
     fn words(&self, b: &State) -> Vec<u32> {
-        let phases = &self.model.phases;
-        b.positions
-            .iter()
-            .zip(&b.ids)
-            .map(|(x, &id)| {
-                let mobile = phases[x[3].to_bits() as usize].mobile;
-                if mobile { self.regions[id as usize] } else { 0 }
-            })
-            .collect()
+        let words = b.positions.iter().zip(&b.ids);
+        words.map(|(x, &id)| self.word(x, id)).collect()
+    }
+
+    /// The region word of particle `id` at `x`: the last rheology pass's if its phase is
+    /// mobile, else 0.
+    fn word(&self, x: &[f32; 4], id: u32) -> u32 {
+        let mobile = self.model.phases[x[3].to_bits() as usize].mobile;
+        if mobile { self.regions[id as usize] } else { 0 }
     }
 
     /// (Rheology and release, then) forces and stable steps of the active particles of `b`
