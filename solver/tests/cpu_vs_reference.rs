@@ -92,6 +92,11 @@ fn rheology_matches_the_oracle_with_the_waters_eddy_viscosity() {
 }
 
 #[test]
+fn rheology_wears_the_held_bed_as_the_oracle_does() {
+    sand_stages::check_worn_away_pickup(&CPU, 26);
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     parked::check_parked_take_no_part(&CPU);
 }

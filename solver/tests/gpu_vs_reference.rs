@@ -113,6 +113,11 @@ fn rheology_matches_the_cpu_with_shields_reading_the_waters_own_speed() {
 }
 
 #[test]
+fn rheology_wears_the_held_bed_as_the_cpu_does() {
+    on_gpu(|b| sand_stages::check_worn_away_pickup(b, 26));
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     on_gpu(parked::check_parked_take_no_part);
 }

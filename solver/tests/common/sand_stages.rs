@@ -318,3 +318,92 @@ pub fn shields_only_case() -> Case {
     c.numerics.clamp_negative_pressure = true;
     c
 }
+
+/// [`water_speed_case`] with the pick-up worn away (`Erosion::VanRijnIntegrated`), as the
+/// twin runs: a held grain under a shear past Shields' threshold loses a share of its mass each
+/// step, kept in its region word.
+pub fn worn_away_case() -> Case {
+    let mut c = water_speed_case();
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.erosion = flume_solver::config::Erosion::VanRijnIntegrated;
+    }
+    c
+}
+
+/// The rheology pass with its pick-up draws over 200 steps of [`worn_away_case`] (of 20, 15
+/// and 25 us in turn): after each step but the first, every particle's region word (region,
+/// hold and the mass worn off it) against `pass::rheology_pass_drawn` from the state and words
+/// the step started from, drawn at the step's run count with the previous step's length (the
+/// first step's draw has no length before it, so it wears nothing). Grains must begin to wear
+/// as the churning water's shear passes their threshold, the worn mass carry over from step to
+/// step, and the shares be rounded both down and up.
+pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
+    const STEPS: usize = 200;
+    use flume_solver::physics::sediment::pass::{Draws, rheology_pass_drawn};
+    use flume_solver::physics::sediment::pickup::PICKUP_SHIFT;
+    let c = worn_away_case();
+    let (mut sim, _, params) = sediment_in_motion(backend, &c, seed, |_| {});
+    let model = super::reference_sediment(&sim);
+    assert!(model.pickup_integrated, "the case does not wear the bed");
+    let dts: Vec<f32> = (0..STEPS)
+        .map(|k| [2.0e-5f32, 1.5e-5, 2.5e-5][k % 3])
+        .collect();
+    let mut t = 0.0f64;
+    let mut before = (sim.read_particles().expect("readback"), Vec::new());
+    let (mut started, mut carried, mut grew_by, mut off_by_one) = (0, 0, Vec::new(), 0);
+    for (k, &dt) in dts.iter().enumerate() {
+        t += f64::from(dt);
+        sim.advance_to(t).expect("steps");
+        let words = sim.regions().expect("regions");
+        if k > 0 {
+            let draws = Draws {
+                step: k as u32,
+                dt_s: dts[k - 1],
+            };
+            let (p, w) = &before;
+            let oracle =
+                rheology_pass_drawn(&params, &model, &p.positions, &p.vel_rho, w, Some(draws));
+            for (i, r) in oracle.iter().enumerate() {
+                let (got, want) = (words[i], r.word());
+                // The region and the hold to the bit; the worn units within one, where the
+                // share's fraction, its rate summed in another order (or its step an ulp
+                // apart), falls on the other side of the draw.
+                let (units, want_units) = (got >> PICKUP_SHIFT, want >> PICKUP_SHIFT);
+                assert!(
+                    got & 511 == want & 511 && units.abs_diff(want_units) <= 1,
+                    "step {}: particle {i} word {got:#x}, the oracle's {want:#x}",
+                    k + 1
+                );
+                off_by_one += usize::from(units != want_units);
+                let was = w[i] >> PICKUP_SHIFT;
+                if want_units > 0 && was == 0 {
+                    started += 1;
+                }
+                if want_units > was && was > 0 {
+                    carried += 1;
+                }
+                if want_units > was {
+                    grew_by.push(want_units - was);
+                }
+            }
+        }
+        before = (sim.read_particles().expect("readback"), words);
+    }
+    let share_rounded_both_ways = grew_by.iter().min() != grew_by.iter().max();
+    eprintln!(
+        "{started} grains began to wear, {carried} wore on from the step before; shares {:?} to {:?} units; {off_by_one} a unit off",
+        grew_by.iter().min(),
+        grew_by.iter().max()
+    );
+    // A draw at another step or id than the oracle's rounds a third of the shares otherwise.
+    assert!(
+        off_by_one * 50 <= grew_by.len(),
+        "{off_by_one} of {} shares rounded otherwise",
+        grew_by.len()
+    );
+    assert!(
+        started > 0 && carried > 0,
+        "nothing wore, or nothing carried over"
+    );
+    assert!(share_rounded_both_ways, "every share was rounded alike");
+}
