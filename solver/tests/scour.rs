@@ -1,7 +1,9 @@
 //! Tier 3 for the scour model: the paper's cases at CI size, checked for physical sense (the
 //! experiments have no public numbers; `shared/validation/README.md`) and for what the open
 //! flume promises: the inlet follows the discharge, nothing is lost, erosion grows with the
-//! bed's roughness.
+//! bed's roughness. The physics runs on the backend `simulate` chooses (`common::chosen`: the
+//! CPU backend where only lavapipe is), the flume's machinery in shaders on the wgpu backend:
+//! recycling, the outlet and the collector, the recovery from a blow-up.
 
 mod common;
 
@@ -48,12 +50,12 @@ fn assert_nothing_leaks(
 #[test]
 fn ulbra_with_no_inflow_erodes_nothing() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
+    let backend = common::chosen();
     let mut c = ulbra_ci();
     if let Some(f) = c.open_flume.as_mut() {
         f.inflow_m3_per_s = 0.0;
     }
-    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    let mut sim = Simulation::new(backend, &c).expect("case builds");
     let start = sim.read_particles().expect("reads");
     sim.advance_to(1.0).expect("runs");
     let obs = sim.observe().expect("observes");
@@ -72,12 +74,12 @@ fn ulbra_with_no_inflow_erodes_nothing() {
 /// Runs the CI flume for `end_s`, the discharge following `series` (time, m3/s, each held to
 /// the next), and returns the simulation and the integral of the discharge, m3.
 fn run_series(
-    gpu: &std::sync::Arc<flume_solver::GpuContext>,
+    backend: &flume_solver::Backend,
     series: &[(f64, f64)],
     end_s: f64,
 ) -> (Simulation, f64) {
     let c = ulbra_ci();
-    let mut sim = Simulation::new(std::sync::Arc::clone(gpu), &c).expect("case builds");
+    let mut sim = Simulation::new(backend.clone(), &c).expect("case builds");
     let mut volume = 0.0;
     for (k, &(t0, q)) in series.iter().enumerate() {
         sim.set_boundary_conditions(BoundaryConditions { inflow_m3_per_s: q })
@@ -134,12 +136,12 @@ fn assert_inlet_runs_at(sim: &Simulation, c: &Case, q: f64) {
 #[test]
 fn ulbra_discharge_series_drives_the_inlet_and_raises_the_gauges() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
+    let backend = common::chosen();
     let c = ulbra_ci();
     let f = c.open_flume.clone().expect("open flume");
     let dp = c.numerics.dp_m;
-    let (steady, _) = run_series(&gpu, &[(0.0, Q_ULBRA)], 2.0);
-    let (mut stepped, volume) = run_series(&gpu, &[(0.0, Q_ULBRA), (1.0, 2.0 * Q_ULBRA)], 2.0);
+    let (steady, _) = run_series(&backend, &[(0.0, Q_ULBRA)], 2.0);
+    let (mut stepped, volume) = run_series(&backend, &[(0.0, Q_ULBRA), (1.0, 2.0 * Q_ULBRA)], 2.0);
     let fl = stepped.flume().expect("flume");
     let entered = fl.injected_particles as f64;
     let expected = volume / f.width_m / (dp * dp);
@@ -186,14 +188,14 @@ fn ulbra_discharge_series_drives_the_inlet_and_raises_the_gauges() {
 #[test]
 fn ulbra_erosion_grows_with_bed_roughness() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
+    let backend = common::chosen();
     let mut eroded = Vec::new();
     for ks in [1.0, 7.0] {
         let mut c = ulbra_ci();
         if let Some(s) = c.phases[1].sediment.as_mut() {
             s.ks_over_d50 = ks;
         }
-        let mut sim = Simulation::new(std::sync::Arc::clone(&gpu), &c).expect("case builds");
+        let mut sim = Simulation::new(backend.clone(), &c).expect("case builds");
         let start = sim.read_particles().expect("reads");
         let mut samples = 0u64;
         for k in 1..=15 {
@@ -333,14 +335,14 @@ fn assert_scour_hole(obs: &flume_solver::Observations, zs0: &[f64], dp: f64, t: 
 #[test]
 fn louvain_dam_break_scours_below_the_gate_and_the_bed_holds() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
+    let backend = common::chosen();
     let mut c = Case::from_path(&common::case_path(
         "../launch_configs/louvain_dambreak.yaml",
     ))
     .expect("case parses");
     c.numerics.dp_m = 0.005;
     let dp = c.numerics.dp_m;
-    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    let mut sim = Simulation::new(backend, &c).expect("case builds");
     let initial = sim.read_particles().expect("reads");
     let zs0: Vec<f64> = sim
         .observe()
@@ -470,7 +472,7 @@ fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
 #[test]
 fn falappi_flushing_scours_in_front_of_the_outlet_only() {
     let _l = common::gpu_lock();
-    let Some(gpu) = common::gpu() else { return };
+    let backend = common::chosen();
     let mut c = Case::from_path(&common::case_path(
         "../launch_configs/falappi_flushing.yaml",
     ))
@@ -481,7 +483,7 @@ fn falappi_flushing_scours_in_front_of_the_outlet_only() {
     let (q, width) = (f.inflow_m3_per_s, f.width_m);
     let dp = c.numerics.dp_m;
     let end_s = 1.5;
-    let mut sim = Simulation::new(gpu, &c).expect("case builds");
+    let mut sim = Simulation::new(backend, &c).expect("case builds");
     let start = sim.read_particles().expect("reads");
     let before = sim.observe().expect("observes");
     sim.advance_to(end_s).expect("runs");

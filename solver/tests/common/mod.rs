@@ -17,6 +17,15 @@ pub fn gpu_lock() -> MutexGuard<'static, ()> {
     LOCK.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// The backend `simulate` chooses (`Backend::choose`): `FLUME_TWIN_ADAPTER`, else a hardware
+/// GPU, else the CPU backend, which runs a flume some five times faster than lavapipe on the
+/// same cores. The physics of whole cases runs on it; the wgpu stages are held to their CPU
+/// oracles on lavapipe (`gpu_vs_reference.rs`), and both backends to each other on whole cases
+/// (`cases.rs`, `whole_session.rs`, `weir.rs`).
+pub fn chosen() -> Backend {
+    Backend::choose().expect("FLUME_TWIN_ADAPTER names an adapter this machine has")
+}
+
 /// The adapter, or None outside CI when this machine has none (then the test says so and
 /// passes); under CI=true a missing adapter fails the test, since CI has lavapipe.
 pub fn gpu() -> Option<Arc<GpuContext>> {
