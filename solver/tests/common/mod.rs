@@ -11,7 +11,8 @@ pub mod stages;
 use flume_solver::{Backend, GpuContext, Particles};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
-/// GPU tests run one at a time: lavapipe already uses every core.
+/// GPU tests, and the whole cases on [`chosen`], run one at a time: lavapipe and the CPU
+/// backend each already use every core.
 pub fn gpu_lock() -> MutexGuard<'static, ()> {
     static LOCK: Mutex<()> = Mutex::new(());
     LOCK.lock().unwrap_or_else(|e| e.into_inner())
