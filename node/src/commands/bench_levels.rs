@@ -12,6 +12,8 @@
 //!   (`hydraulics::PitFlow`) and with Strickler's n -/+20 %;
 //! - the discharge over the weir and the one the inlet placed, over the last 10 s, against the
 //!   discharge asked (particles parked at the outlet, dp^2 each per metre of width);
+//! - the run in 10 s windows from its start, the case's gauges' levels and the weir's
+//!   discharge in each, and the window from which it stayed steady (`bench_steadiness`);
 //! - at the end, the pool gauge's column: what it passes, and the weir's head counted as energy
 //!   against the rating's over an even approach (a current that has not spread down carries
 //!   velocity head where a still pool holds level);
@@ -24,6 +26,7 @@
 //!
 //! Nothing is asserted: the figures are for the log and the issue's goals.
 
+use super::bench_steadiness::{self, Window};
 use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
 use flume_solver::bed_contact::bed_contact;
@@ -59,6 +62,21 @@ struct Books {
     eroded: u64,
     excluded: u64,
     soaked: u64,
+}
+
+impl Books {
+    /// The particles the inlet placed and those that left over the weir since `first`.
+    fn since(&self, first: &Books) -> (f64, f64) {
+        let d = |a: u64, b: u64| a as f64 - b as f64;
+        // A parked particle left over the weir, reached the collector (sediment), was excluded
+        // or went into the bed's pores; the inlet takes its particles from the parked ones.
+        let injected = d(self.injected, first.injected);
+        let over_weir = d(self.parked, first.parked) + injected
+            - d(self.eroded, first.eroded)
+            - d(self.excluded, first.excluded)
+            - d(self.soaked, first.soaked);
+        (injected, over_weir)
+    }
 }
 
 pub fn run(flume: &Path, set: &[String], runs: &[LevelRun]) -> Result<()> {
@@ -159,6 +177,15 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
     );
     print_levels(case, channel, r, &history);
     print_flow(case, r, &history);
+    let gauges: Vec<String> = case
+        .observations
+        .gauges
+        .iter()
+        .map(|g| g.name.clone())
+        .collect();
+    // The pool's gauge is the benchmark's own; the issue's goals are the case's gauges'.
+    let own = &gauges[..gauges.len().saturating_sub(1)];
+    bench_steadiness::print(own, &windows(case, r, own.len(), &history));
     let particles = sim.read_particles()?;
     // Particles come in id order, as the region words do.
     let regions = sim.regions()?;
@@ -253,6 +280,45 @@ fn print_levels(case: &Case, channel: &Channel, r: &LevelRun, history: &[(Books,
     print!("{table}");
 }
 
+/// The run in windows of [`WINDOW_S`] from its start: the mean level of each of the first
+/// `gauges` gauges, and the weir's discharge against the one asked.
+fn windows(
+    case: &Case,
+    r: &LevelRun,
+    gauges: usize,
+    history: &[(Books, Observations)],
+) -> Vec<Window> {
+    let dp = case.numerics.dp_m;
+    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
+    let asked = r.m3_per_h / 3600.0 / width;
+    let mut out = Vec::new();
+    let mut from = 0.0;
+    while from + WINDOW_S <= r.until_s + 1e-6 {
+        let to = from + WINDOW_S;
+        let ends = (at(history, from), at(history, to));
+        let (Some((first, _)), Some((last, _))) = ends else {
+            break;
+        };
+        // The first window's books start at the first observation.
+        let span = last.t - first.t;
+        if span <= 0.0 {
+            break;
+        }
+        let over_weir = last.since(first).1 * dp * dp / span / asked;
+        let levels_m = (0..gauges)
+            .map(|g| mean_level(history, g, from, to))
+            .collect();
+        out.push(Window {
+            from_s: from,
+            to_s: to,
+            levels_m,
+            over_weir,
+        });
+        from = to;
+    }
+    out
+}
+
 /// The 1-D reference's geometry, weir, friction, pit and eddy viscosity at discharge `q`
 /// (m3/s) over `width` (m).
 fn print_reference(channel: &Channel, q: f64, width: f64) {
@@ -288,14 +354,8 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
     if span <= 0.0 {
         return;
     }
+    let (injected, over_weir) = last.since(first);
     let d = |a: u64, b: u64| a as f64 - b as f64;
-    // A parked particle left over the weir, reached the collector (sediment), was excluded or
-    // went into the bed's pores; the inlet takes its particles from the parked ones.
-    let injected = d(last.injected, first.injected);
-    let over_weir = d(last.parked, first.parked) + injected
-        - d(last.eroded, first.eroded)
-        - d(last.excluded, first.excluded)
-        - d(last.soaked, first.soaked);
     let to_m3_per_h = |n: f64| n * dp * dp * width / span * 3600.0;
     println!(
         "over the last {span:.0} s: inflow placed {:.3} m3/h, over the weir {:.3} m3/h \

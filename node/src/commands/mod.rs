@@ -4,6 +4,7 @@
 pub mod bench;
 mod bench_frames;
 mod bench_levels;
+mod bench_steadiness;
 pub mod make_session;
 pub mod play;
 pub mod replay;
