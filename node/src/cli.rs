@@ -340,7 +340,8 @@ pub struct BenchArgs {
     pub steps_seconds: f64,
     /// Run the --flume case at a constant discharge to a steady state at each --dp instead,
     /// and print its levels against the 1-D hydraulic reference, its outflow against its
-    /// inflow, and the water's stand-off from the bed.
+    /// inflow, the run in 10 s windows with the one from which it stayed steady, and the
+    /// water's stand-off from the bed.
     #[arg(long, conflicts_with_all = ["ladder", "case", "frames"])]
     pub levels: bool,
     /// With --levels: the resolutions to run, m.

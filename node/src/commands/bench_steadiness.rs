@@ -88,8 +88,8 @@ pub fn print(gauges: &[String], windows: &[Window]) {
             100.0 * FLOW_SHARE
         ),
         None => println!(
-            "not steady: the last window moved a gauge by {:.0} mm or more, or the weir by more \
-             than {:.0} %",
+            "not steady: the last window moved a gauge by {:.0} mm or more, found one dry, or \
+             had the weir more than {:.0} % off the inflow",
             1e3 * DRIFT_M,
             100.0 * FLOW_SHARE
         ),
