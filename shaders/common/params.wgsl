@@ -31,9 +31,9 @@ struct Sediment {
     submerged_weight: f32,   // (rho_s - rho_w) |g|, N/m3 (Eq. 16 without theta and d)
     pickup_per_s: f32,       // van Rijn's pick-up rate per unit T^1.5, 1/s (0: Shields releases at once)
     pickup_integrated: u32,  // 1: a held particle leaves once the rate's integral has taken its mass
+    exner_step_per_stage: f32, // van Rijn's saltation length per unit T^0.9 over dp (0: no deposition)
+    dp: f32,                 // particle spacing, m
     pad0: u32,
-    pad1: u32,
-    pad2: u32,
 }
 
 // The open flume (2-D); enabled == 0 for a closed tank.

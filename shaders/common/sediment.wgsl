@@ -24,6 +24,8 @@ const REGION_HELD: u32 = 256u;
 // (`PICKUP_SHIFT`, `PICKUP_WHOLE` of pickup.rs).
 const PICKUP_SHIFT: u32 = 9u;
 const PICKUP_WHOLE: u32 = 8388608u;
+// The bed load of a particle that is not held at the bed's surface (`NO_FLUX` of pass.rs).
+const NO_FLUX: f32 = -1.0;
 
 // Eq. 17 (van Rijn 1993); "infinite" (HUGE) at Re* <= 0.
 fn critical_shields(re_star: f32) -> f32 {
@@ -270,6 +272,22 @@ fn integrated_pickup(units: u32, id: u32, step: u32, rate: f32, dt: f32) -> u32 
     let share = clamp(rate * dt, 0.0, 1.0) * f32(PICKUP_WHOLE);
     let fraction = f32(pickup_draw(id, step) >> 8u) * (1.0 / 16777216.0);
     return units + u32(share + fraction);
+}
+
+// The bed load a held surface particle passes on downstream, particles per second: its pick-up
+// `rate` carried van Rijn's saltation length (`bed_load_flux` in pickup.rs).
+fn bed_load_flux(rate: f32, tau_b: f32, tau_bcr: f32) -> f32 {
+    let stage = max(tau_b / tau_bcr - 1.0, 0.0);
+    return rate * params.sediment.exner_step_per_stage * select(0.0, pow(stage, 0.9), stage > 0.0);
+}
+
+// The mass worn off a held particle after a step of `dt` with `net` per second worn (negative:
+// settled), from `units` before: PICKUP_WHOLE or more once none is left, never below none
+// (`exner_pickup` in pickup.rs; the step's share rounded down or up by the particle's draw).
+fn exner_pickup(units: u32, id: u32, step: u32, net: f32, dt: f32) -> u32 {
+    let share = clamp(net * dt, -1.0, 1.0) * f32(PICKUP_WHOLE);
+    let fraction = f32(pickup_draw(id, step) >> 8u) * (1.0 / 16777216.0);
+    return u32(max(i32(units) + i32(floor(share + fraction)), 0));
 }
 
 // A sediment particle's region (Figure 2 with the hold; `sediment_region` in pass.rs): in the

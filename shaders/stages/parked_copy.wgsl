@@ -2,7 +2,7 @@
 // sorted copy back into the state buffers: the integrators write the new state in cell order
 // but run over the active particles only, so the tail of that order is filled here. Dispatched
 // over the parked particles only. A parked particle has no region (the rheology pass never
-// sees it), as the CPU backend has it.
+// sees it) and passes no bed load on, as the CPU backend has it.
 
 @group(0) @binding(1) var<storage, read_write> state: StepState;
 @group(0) @binding(2) var<storage, read> cell_starts: array<u32>;
@@ -30,4 +30,8 @@ fn parked_copy(@builtin(global_invocation_id) gid: vec3<u32>) {
     // At rest in both of Verlet's sequences, as the inlet places it.
     vel_rho_prev_out[k] = vr;
     regions[ids_n[k]] = 0u;
+    // Nor any bed load passed on, in either step's slot (NO_FLUX; REGION_SLOTS of state.rs).
+    let no_flux = bitcast<u32>(-1.0);
+    regions[params.n_particles + ids_n[k]] = no_flux;
+    regions[2u * params.n_particles + ids_n[k]] = no_flux;
 }

@@ -95,11 +95,47 @@ struct Chosen {
     region: u32,
     mu: f32,
     pickup: u32,   // the mass picked up of a held particle so far (pickup.rs)
+    flux: f32,     // the bed load it passes on (pass.rs's ParticleRheology::flux)
 }
 
-// Sediment particle i's region and apparent viscosity from its sums, its density and II_D:
-// the Shields chain at the surface, the pick-up draw, Figure 2's region.
-fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
+// Where in `regions` the fluxes of the pass at run step `step` lie: after the words, the even
+// steps' then the odd steps' (`REGION_SLOTS` of state.rs).
+fn flux_slot(step: u32) -> u32 {
+    return params.n_particles * (1u + (step & 1u));
+}
+
+// The bed load that the held particle upstream of the sediment particle at pos_i passed on in
+// the last step's pass, read from `slot` (`Upstream` of pass.rs): of the held particles at the
+// surface, the one nearest the point dp up the flow of the nearest water, within dp of it.
+fn upstream_flux(pos_i: vec3<f32>, g: Gathered, slot: u32) -> f32 {
+    let dp = params.sediment.dp;
+    let at = pos_i - dp * g.nearest_u / length(g.nearest_u);
+    var best_d2 = dp * dp;
+    var best = 0.0;
+    let cell = cell_coords(pos_i);
+    for (var row = 0u; row < STENCIL_ROWS; row++) {
+        let range = stencil_row(cell, row);
+        for (var j = range.x; j < range.y; j++) {
+            let pos_j = textureLoad(positions, texel(j), 0).xyz;
+            let flux_j = bitcast<f32>(regions[slot + ids[j]]);
+            if (flux_j < 0.0 || all(pos_j == pos_i)) {
+                continue;
+            }
+            let d = pos_j - at;
+            let d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+            // The lesser flux of two at the same distance: the same choice in any order.
+            if (d2 < best_d2 || (d2 == best_d2 && flux_j < best)) {
+                best_d2 = d2;
+                best = flux_j;
+            }
+        }
+    }
+    return best;
+}
+
+// Sediment particle i at pos_i: its region and apparent viscosity from its sums, its density
+// and II_D: the Shields chain at the surface, the pick-up draw, Figure 2's region.
+fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
     let sd = params.sediment;
     let tau_y = drucker_prager_yield(rho_i);
     let has_water = g.nearest_r2 < HUGE;
@@ -125,10 +161,23 @@ fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
     // The pass before the step's size is chosen draws the pick-ups, one draw a step.
     var picked = sd.pickup_per_s == 0.0;
     var pickup = select(before >> PICKUP_SHIFT, 0u, picked);
+    let rate = pickup_rate(tau_b, tau_bcr);
+    // Worn net of what settles from upstream: Exner's balance (`van_rijn_exner`).
+    let exner = sd.exner_step_per_stage > 0.0;
+    let flux = bed_load_flux(rate, tau_b, tau_bcr);
     if (!picked && BEFORE_DT) {
         let step = state.run_steps + state.steps;
-        let rate = pickup_rate(tau_b, tau_bcr);
-        if (sd.pickup_integrated != 0u) {
+        if (exner) {
+            var upstream = 0.0;
+            if (held_before && at_surface && length(g.nearest_u) > 0.0) {
+                upstream = upstream_flux(pos_i, g, flux_slot(step + 1u));
+            }
+            // E - D with D >= 0: never more than what is picked up from it.
+            let net = min(flux - upstream, rate);
+            let worn = exner_pickup(pickup, ids[i], step, net, state.dt_taken);
+            picked = worn >= PICKUP_WHOLE;
+            pickup = select(worn, 0u, picked);
+        } else if (sd.pickup_integrated != 0u) {
             let worn = integrated_pickup(pickup, ids[i], step, rate, state.dt_taken);
             picked = worn >= PICKUP_WHOLE;
             pickup = select(worn, 0u, picked);
@@ -143,7 +192,9 @@ fn sediment_rheology(i: u32, rho_i: f32, g: Gathered, ii_d: f32) -> Chosen {
     ));
     // What was worn off a particle stays with it while it is held, and only then.
     let kept = select(0u, pickup, region == REGION_UNYIELDED && held_before);
-    return Chosen(region, region_viscosity(region, ii_d, tau_y, tau_bcr, c_v), kept);
+    let passed = exner && !picked && region == REGION_UNYIELDED && at_surface;
+    let mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
+    return Chosen(region, mu, kept, select(NO_FLUX, flux, passed));
 }
 
 @compute @workgroup_size(64)
@@ -161,6 +212,9 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
         textureStore(stress_a, texel(i), vec4<f32>(0.0));
         textureStore(stress_b, texel(i), vec4<f32>(0.0));
         regions[ids[i]] = 0u;
+        if (BEFORE_DT) {
+            regions[flux_slot(state.run_steps + state.steps) + ids[i]] = bitcast<u32>(NO_FLUX);
+        }
         return;
     }
     let sd = params.sediment;
@@ -188,11 +242,13 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     var mu = ph_i.mu + sps_viscosity(rho_i, ii_d);
     var region = REGION_WATER;
     var pickup = 0u;
+    var flux = NO_FLUX;
     if (is_sediment) {
-        let chosen = sediment_rheology(i, rho_i, g, ii_d);
+        let chosen = sediment_rheology(i, pos_i.xyz, rho_i, g, ii_d);
         region = chosen.region;
         mu = chosen.mu;
         pickup = chosen.pickup;
+        flux = chosen.flux;
     }
     // Shields-only holds carry no stress; Drucker-Prager holds keep theirs (hold.rs).
     let held = region == REGION_UNYIELDED;
@@ -205,4 +261,8 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     // By particle id: the integrators, the probes and the host each see the particles in a
     // different order.
     regions[ids[i]] = word | (pickup << PICKUP_SHIFT);
+    // The pass that wears the bed passes its bed load on to the next one's.
+    if (BEFORE_DT) {
+        regions[flux_slot(state.run_steps + state.steps) + ids[i]] = bitcast<u32>(flux);
+    }
 }

@@ -95,13 +95,14 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
 }
 
 /// The same under the symplectic scheme, whose corrector's passes read the predictor's holds
-/// and the half step's velocities.
+/// and the half step's velocities, with the held bed worn net of what settles from upstream
+/// (`van_rijn_exner`), whose pass reads the bed load its neighbours passed on the step before.
 #[test]
 fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
     let case = ulbra(&[
         "numerics.boundary={method: generalised}",
         "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
-        "phases.1.sediment.erosion=van_rijn_integrated",
+        "phases.1.sediment.erosion=van_rijn_exner",
         "phases.1.sediment.shields_speed=water",
         "numerics.integrator={method: symplectic}",
     ]);

@@ -500,12 +500,24 @@ fn the_erosion_reaches_both_backends_and_a_wrong_one_is_named() {
         ("threshold", false, 0),
         ("van_rijn_pickup", true, 0),
         ("van_rijn_integrated", true, 1),
+        ("van_rijn_exner", true, 1),
     ] {
         let (sim, model) = flume_with(&[&format!("phases.1.sediment.erosion={erosion}")]);
         let block = sim.params().sediment;
         assert_eq!(block.pickup_per_s > 0.0, rate, "{erosion}");
         assert_eq!(block.pickup_integrated, integrated, "{erosion}");
         assert_eq!(model.pickup_integrated, integrated == 1, "{erosion}");
+        // The saltation length over dp = 2 cm (pickup.rs: 4.8456e-3 m): Exner's only.
+        let step = if erosion == "van_rijn_exner" {
+            0.242_28
+        } else {
+            0.0
+        };
+        assert!(
+            (model.exner_step_per_stage - step).abs() < 1e-5,
+            "{erosion}: {model:?}"
+        );
+        assert_eq!(model.dp_m, 0.02);
     }
     let (f, r) = refused(&ULBRA.replace(
         "      criterion: shields_only\n",

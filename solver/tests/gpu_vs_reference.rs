@@ -118,6 +118,11 @@ fn rheology_wears_the_held_bed_as_the_cpu_does() {
 }
 
 #[test]
+fn rheology_wears_the_held_bed_net_of_what_settles_as_the_cpu_does() {
+    on_gpu(|b| sand_stages::check_exner_pickup(b, 26));
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     on_gpu(parked::check_parked_take_no_part);
 }

@@ -212,6 +212,7 @@ fn every_constant_stated_on_both_sides_agrees() {
         ("rheology", "REGION_HELD", U32(pass::REGION_HELD)),
         ("rheology", "PICKUP_SHIFT", U32(pickup::PICKUP_SHIFT)),
         ("rheology", "PICKUP_WHOLE", U32(pickup::PICKUP_WHOLE)),
+        ("rheology", "NO_FLUX", F32(pass::NO_FLUX)),
         (
             "symplectic_predictor",
             "REGION_HELD_BIT",
@@ -347,7 +348,12 @@ fn rust_mirrors_have_the_wgsl_layout() {
         dp_kappa,
         phi,
         mu_max,
-        submerged_weight
+        submerged_weight,
+        water_speed,
+        pickup_per_s,
+        pickup_integrated,
+        exner_step_per_stage,
+        dp
     );
     let (m, size) = wgsl_layout(&module, "Phase");
     assert_eq!(size as usize, size_of::<PhaseParams>());

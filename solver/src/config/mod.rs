@@ -272,6 +272,12 @@ pub enum Erosion {
     /// wears a fraction of a particle off, as it takes a fraction of a millimetre off the real
     /// bed, where a chance each step lifts a whole particle here and there.
     VanRijnIntegrated,
+    /// Worn away as `van_rijn_integrated`, net of the bed load that settles on the particle
+    /// from the one upstream (Exner's balance: what each passes on is its pick-up times van
+    /// Rijn's 1984 saltation length, `physics::sediment::pickup::bed_load_flux`). A bed under a
+    /// flow the same all along it then neither wears nor roughens; it wears where the flow
+    /// quickens and fills where it slows.
+    VanRijnExner,
 }
 
 /// The u of the log law (Eqs. 19-21) that the Shields test reads from the nearest water

@@ -41,7 +41,9 @@ pub struct SedimentGpu {
     pub submerged_weight: f32,
     pub pickup_per_s: f32,
     pub pickup_integrated: u32,
-    pub pad: [u32; 3],
+    pub exner_step_per_stage: f32,
+    pub dp: f32,
+    pub pad: u32,
 }
 
 /// `Flume` of `shaders/common/params.wgsl` (units there).

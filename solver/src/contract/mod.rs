@@ -18,7 +18,7 @@ use crate::health::{RHO_RATIO_EXCLUDE, RHO_RATIO_MAX};
 use crate::particles::{Parking, parked_phase};
 use crate::physics::sediment::SedimentParams;
 use crate::physics::sediment::pass::SedimentModel;
-use crate::physics::sediment::pickup::pickup_per_s;
+use crate::physics::sediment::pickup::{pickup_per_s, saltation_length_per_stage};
 use bytemuck::Zeroable;
 
 pub fn sim_params(
@@ -218,17 +218,36 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
         submerged_weight: ((rho_s - rho_w) * case.gravity_magnitude()) as f32,
         pickup_per_s: match cfg.erosion {
             Erosion::Threshold => 0.0,
-            Erosion::VanRijnPickup | Erosion::VanRijnIntegrated => pickup_per_s(
-                cfg.d50_m,
-                rho_s,
-                rho_w,
-                water.viscosity_pa_s / rho_w,
-                case.gravity_magnitude(),
-                case.numerics.dp_m,
-            ) as f32,
+            Erosion::VanRijnPickup | Erosion::VanRijnIntegrated | Erosion::VanRijnExner => {
+                pickup_per_s(
+                    cfg.d50_m,
+                    rho_s,
+                    rho_w,
+                    water.viscosity_pa_s / rho_w,
+                    case.gravity_magnitude(),
+                    case.numerics.dp_m,
+                ) as f32
+            }
         },
-        pickup_integrated: u32::from(cfg.erosion == Erosion::VanRijnIntegrated),
-        pad: [0; 3],
+        pickup_integrated: u32::from(matches!(
+            cfg.erosion,
+            Erosion::VanRijnIntegrated | Erosion::VanRijnExner
+        )),
+        exner_step_per_stage: match cfg.erosion {
+            Erosion::VanRijnExner => {
+                let length = saltation_length_per_stage(
+                    cfg.d50_m,
+                    rho_s,
+                    rho_w,
+                    water.viscosity_pa_s / rho_w,
+                    case.gravity_magnitude(),
+                );
+                (length / case.numerics.dp_m) as f32
+            }
+            _ => 0.0,
+        },
+        dp: case.numerics.dp_m as f32,
+        pad: 0,
     }
 }
 
@@ -262,5 +281,7 @@ pub fn sediment_model(case: &Case, derived: &Derived) -> Option<SedimentModel> {
         mu_max: block.mu_max,
         pickup_per_s: block.pickup_per_s,
         pickup_integrated: block.pickup_integrated != 0,
+        exner_step_per_stage: block.exner_step_per_stage,
+        dp_m: block.dp,
     })
 }

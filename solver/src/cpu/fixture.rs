@@ -73,6 +73,8 @@ fn sediment() -> SedimentModel {
         mu_max: 50.0,
         pickup_per_s: 0.0,
         pickup_integrated: false,
+        exner_step_per_stage: 0.0,
+        dp_m: 0.01,
     }
 }
 

@@ -24,7 +24,7 @@ use crate::engine::{PipelineShape, by_id};
 use crate::error::SolverError;
 use crate::particles::Particles;
 use crate::physics;
-use crate::physics::sediment::pass::SedimentModel;
+use crate::physics::sediment::pass::{NO_FLUX, SedimentModel};
 use crate::physics::sediment::suspension::Region;
 use grid::Grid;
 use std::sync::Arc;
@@ -88,7 +88,10 @@ pub struct CpuEngine {
     a: State,
     /// Region words by id (region | REGION_HELD), as the last rheology pass left them.
     regions: Vec<u32>,
-    snapshot: (State, Vec<u32>),
+    /// The bed load each held particle at the surface passed on in the last pass that drew
+    /// (`van_rijn_exner`), by id; `NO_FLUX` for any other.
+    fluxes: Vec<f32>,
+    snapshot: (State, Vec<u32>, Vec<f32>),
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
     seconds: [f64; STAGES.len()],
@@ -128,6 +131,7 @@ impl CpuEngine {
             vel_rho_prev: particles.vel_rho.clone(),
         };
         let regions = vec![0; particles.len()];
+        let fluxes = vec![NO_FLUX; particles.len()];
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
             pool: Arc::new(pool),
@@ -135,9 +139,10 @@ impl CpuEngine {
             model: params.physics(shape.dim, n_phases),
             shape,
             sediment: sediment.filter(|_| params.viscosity_mode == VISCOSITY_MULTIPHASE),
-            snapshot: (a.clone(), regions.clone()),
+            snapshot: (a.clone(), regions.clone(), fluxes.clone()),
             a,
             regions,
+            fluxes,
             probe_points: probe_points.to_vec(),
             seconds: [0.0; STAGES.len()],
             awake_set,
@@ -191,11 +196,13 @@ impl Engine for CpuEngine {
     fn save(&mut self) {
         self.snapshot.0.clone_from(&self.a);
         self.snapshot.1.clone_from(&self.regions);
+        self.snapshot.2.clone_from(&self.fluxes);
     }
 
     fn restore(&mut self) {
         self.a.clone_from(&self.snapshot.0);
         self.regions.clone_from(&self.snapshot.1);
+        self.fluxes.clone_from(&self.snapshot.2);
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {

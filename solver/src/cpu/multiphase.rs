@@ -10,8 +10,9 @@
 //! water and no velocity difference: it is not at the surface, its strain rate is zero, its
 //! concentration one, and it stays held with the viscosity its own density gives. That is
 //! what [`Rheology::finish`] gives from the particle's own start, to the bit, without the
-//! neighbour loop; its neighbours read only its position, velocity and density, which the
-//! pass does not change. A wall, whose rheology is none, is spared the walk as well.
+//! neighbour loop (and, not at the surface, it passes no bed load on and reads none from
+//! upstream); its neighbours read only its position, velocity and density, which the pass
+//! does not change. A wall, whose rheology is none, is spared the walk as well.
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
@@ -20,7 +21,8 @@ use crate::physics::interaction::phase_index;
 use crate::physics::lanes::{LANES, Lanes};
 use crate::physics::sediment::hold::{Release, Transmitted};
 use crate::physics::sediment::pass::{
-    Draws, ParticleRheology, REGION_HELD, Rheology, RheologySide, RheologySums, SedimentModel,
+    Draws, NO_FLUX, ParticleRheology, REGION_HELD, Rheology, RheologySide, RheologySums,
+    SedimentModel,
 };
 use crate::physics::sediment::suspension::Region;
 use rayon::prelude::*;
@@ -32,6 +34,9 @@ pub struct Holds<'a> {
     pub words: &'a [u32],
     /// The particles' ids (sorted order): their draws'.
     pub ids: &'a [u32],
+    /// The bed load each held particle at the surface passed on in the last pass, by id
+    /// (`van_rijn_exner`; [`NO_FLUX`] for any other).
+    pub fluxes: &'a [f32],
     pub draws: Option<Draws>,
     /// Whether held grains far from anything moving sleep (see the module doc); false: every
     /// grain runs its sums (the full computation the awake set is checked against).
@@ -88,6 +93,7 @@ pub fn rheology_pass(
         vol: &vol,
         sides: &sides,
         ids: holds.ids,
+        fluxes: holds.fluxes,
         words: holds.words,
         asleep: &asleep,
     };
@@ -98,6 +104,7 @@ pub fn rheology_pass(
         region: 0,
         held: false,
         pickup: 0,
+        flux: NO_FLUX,
     };
     let mut out = vec![none; n];
     let asleep = pool.install(|| {
@@ -175,6 +182,8 @@ struct Pairs<'a> {
     vol: &'a [f32],
     sides: &'a [RheologySide],
     ids: &'a [u32],
+    /// The last pass's bed load by id (`Holds::fluxes`).
+    fluxes: &'a [f32],
     /// The region words of the last pass.
     words: &'a [u32],
     /// The grains that may sleep in this pass.
@@ -202,20 +211,38 @@ impl Pairs<'_> {
                 asleep += group.range.len();
                 for i in group.range.clone() {
                     let s = pass.start(&pos[i], &vel[i]);
-                    let before = self.words[i];
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, self.ids[i]);
+                    let before = (self.words[i], self.ids[i]);
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, 0.0);
                 }
             } else {
                 let sums = self.group(&group);
                 for (lane, i) in group.range.clone().enumerate() {
                     let s = sums.lane(lane);
-                    let before = self.words[i];
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, self.ids[i]);
+                    let upstream = self.upstream(i, &s);
+                    let before = (self.words[i], self.ids[i]);
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, upstream);
                 }
             }
             start = group.range.end;
         }
         asleep
+    }
+
+    /// The bed load the held particle upstream of particle `i` passed on in the last pass, from
+    /// its sums `s` (0: none, or no deposition): the cells within reach hold it, since it
+    /// lies within 2 dp of `i`.
+    fn upstream(&self, i: usize, s: &RheologySums) -> f32 {
+        let Some(mut up) = self.pass.upstream_of(&self.pos[i], s, self.words[i]) else {
+            return 0.0;
+        };
+        let x = &self.pos[i];
+        self.grid
+            .rows(self.grid.coords(&[x[0], x[1], x[2]]), |range| {
+                for j in range {
+                    up.add(&self.pos[j], self.fluxes[self.ids[j] as usize]);
+                }
+            });
+        up.flux()
     }
 
     /// The sums of `group`, from each particle's own start.
@@ -269,11 +296,13 @@ mod tests {
             .map(|i| if i % 3 == 0 { REGION_HELD } else { 0 })
             .collect();
         let ids: Vec<u32> = (0..n as u32).collect();
+        let fluxes = vec![NO_FLUX; n];
         let (params, grid) = (&fx.params, &fx.grid);
         let pass_with = |awake_set| {
             let holds = Holds {
                 words: &held,
                 ids: &ids,
+                fluxes: &fluxes,
                 draws: None,
                 awake_set,
             };
@@ -296,7 +325,7 @@ mod tests {
                         }
                     });
                 }
-                pass.finish(x, v, &s, held[i], ids[i])
+                pass.finish(x, v, &s, (held[i], ids[i]), 0.0)
             })
             .collect();
         let word_bits = |r: &[ParticleRheology]| -> Vec<(u32, u32, Vec<u32>)> {

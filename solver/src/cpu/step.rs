@@ -14,7 +14,7 @@ use crate::health::Health;
 use crate::physics::integrate::{Particle, bed_wall, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
 use crate::physics::sediment::pass::REGION_HELD;
-use crate::physics::sediment::pass::{Draws, ParticleRheology};
+use crate::physics::sediment::pass::{Draws, NO_FLUX, ParticleRheology};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
@@ -147,6 +147,7 @@ impl CpuEngine {
         let holds = Holds {
             words: &words[..active],
             ids: &b.ids[..active],
+            fluxes: &self.fluxes,
             draws,
             awake_set: self.awake_set,
         };
@@ -160,6 +161,15 @@ impl CpuEngine {
         // Parked particles are out of the flow: no region.
         for &id in &b.ids[active..] {
             self.regions[id as usize] = 0;
+        }
+        // The bed load of the pass that wore the bed, which the next one settles downstream.
+        if draws.is_some() {
+            for (r, &id) in pass.out.iter().zip(&b.ids) {
+                self.fluxes[id as usize] = r.flux;
+            }
+            for &id in &b.ids[active..] {
+                self.fluxes[id as usize] = NO_FLUX;
+            }
         }
         Some(pass.out)
     }

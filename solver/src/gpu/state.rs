@@ -26,6 +26,9 @@ pub struct GpuBuffers {
     /// order, and region words (region | REGION_HELD) by particle id.
     pub stress_a: wgpu::TextureView,
     pub stress_b: wgpu::TextureView,
+    /// [`REGION_SLOTS`] runs of one word per particle id: the region words, then the bed load
+    /// each held particle at the surface passed on (f32 bits, `van_rijn_exner`) in the steps
+    /// of even and of odd run count, one read while the other is written.
     pub regions: wgpu::Buffer,
     /// A copy of `regions` taken with `snapshot`: which sediment is held is state too.
     pub regions_snapshot: wgpu::Buffer,
@@ -68,6 +71,9 @@ impl StateTextures {
 
 /// Bytes of one vec4<f32> particle attribute (positions, velocity-density, forces).
 pub const VEC4_BYTES: u64 = 16;
+
+/// The runs of one word per particle in `GpuBuffers::regions`: words and two steps' fluxes.
+pub const REGION_SLOTS: u64 = 3;
 
 impl GpuBuffers {
     /// Checks every large buffer against the adapter's limits before anything is allocated.
@@ -143,8 +149,8 @@ impl GpuBuffers {
             c: StateTextures::new(gpu, "c", n),
             stress_a: particle_texture(gpu, "stress_a", n, TEXEL_ROW_SHIFT),
             stress_b: particle_texture(gpu, "stress_b", n, TEXEL_ROW_SHIFT),
-            regions: storage(gpu, "regions", n * 4),
-            regions_snapshot: storage(gpu, "regions snapshot", n * 4),
+            regions: storage(gpu, "regions", n * 4 * REGION_SLOTS),
+            regions_snapshot: storage(gpu, "regions snapshot", n * 4 * REGION_SLOTS),
             forces: storage(gpu, "forces", n * VEC4_BYTES),
             cell_of: storage(gpu, "cell_of", n * 4),
             cell_starts: storage(gpu, "cell_starts", u64::from(n_cells + 1) * 4),

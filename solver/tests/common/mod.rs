@@ -189,7 +189,8 @@ pub fn reference_sediment(
         pickup_per_s: match cfg.erosion {
             flume_solver::config::Erosion::Threshold => 0.0,
             flume_solver::config::Erosion::VanRijnPickup
-            | flume_solver::config::Erosion::VanRijnIntegrated => {
+            | flume_solver::config::Erosion::VanRijnIntegrated
+            | flume_solver::config::Erosion::VanRijnExner => {
                 flume_solver::physics::sediment::pickup::pickup_per_s(
                     cfg.d50_m,
                     sed.rho0_kg_per_m3,
@@ -200,7 +201,22 @@ pub fn reference_sediment(
                 ) as f32
             }
         },
-        pickup_integrated: cfg.erosion == flume_solver::config::Erosion::VanRijnIntegrated,
+        pickup_integrated: matches!(
+            cfg.erosion,
+            flume_solver::config::Erosion::VanRijnIntegrated
+                | flume_solver::config::Erosion::VanRijnExner
+        ),
+        // van Rijn (1984a): a saltation length of 3 d50 D*^0.6 T^0.9, over dp.
+        exner_step_per_stage: if cfg.erosion == flume_solver::config::Erosion::VanRijnExner {
+            let nu = water.viscosity_pa_s / water.rho0_kg_per_m3;
+            let submerged =
+                (sed.rho0_kg_per_m3 / water.rho0_kg_per_m3 - 1.0) * case.gravity_magnitude();
+            let d_star = cfg.d50_m * (submerged / (nu * nu)).cbrt();
+            (3.0 * cfg.d50_m * d_star.powf(0.6) / case.numerics.dp_m) as f32
+        } else {
+            0.0
+        },
+        dp_m: case.numerics.dp_m as f32,
     }
 }
 

@@ -330,19 +330,40 @@ pub fn worn_away_case() -> Case {
     c
 }
 
-/// The rheology pass with its pick-up draws over 200 steps of [`worn_away_case`] (of 20, 15
-/// and 25 us in turn): after each step but the first, every particle's region word (region,
-/// hold and the mass worn off it) against `pass::rheology_pass_drawn` from the state and words
-/// the step started from, drawn at the step's run count with the previous step's length (the
-/// first step's draw has no length before it, so it wears nothing). Grains must begin to wear
-/// as the churning water's shear passes their threshold, the worn mass carry over from step to
-/// step, and the shares be rounded both down and up.
-pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
+/// [`worn_away_case`] worn net of what settles from upstream (`Erosion::VanRijnExner`).
+pub fn exner_case() -> Case {
+    let mut c = worn_away_case();
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.erosion = flume_solver::config::Erosion::VanRijnExner;
+    }
+    c
+}
+
+/// What [`check_wear`] saw: grains that began to wear, wore on, and whose wear the bed load
+/// from upstream cut by two units or more (more than the comparison's tolerance).
+pub struct Wear {
+    pub started: usize,
+    pub carried: usize,
+    pub supplied: usize,
+}
+
+/// The rheology pass with its pick-up draws over 200 steps of case `c`, its perturbed speeds
+/// scaled by `calm`, (of 20, 15 and 25 us in turn): after each step but the first, every particle's region word (region, hold and the
+/// mass worn off it) against `pass::rheology_pass_exner` from the state and words the step
+/// started from, drawn at the step's run count with the previous step's length (the first
+/// step's draw has no length before it, so it wears nothing), and from the bed load the
+/// oracle's pass of the step before passed on. Grains must begin to wear as the churning
+/// water's shear passes their threshold, the worn mass carry over from step to step, and the
+/// shares be rounded both down and up.
+pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
     const STEPS: usize = 200;
-    use flume_solver::physics::sediment::pass::{Draws, rheology_pass_drawn};
+    use flume_solver::physics::sediment::pass::{Draws, NO_FLUX, rheology_pass_exner};
     use flume_solver::physics::sediment::pickup::PICKUP_SHIFT;
-    let c = worn_away_case();
-    let (mut sim, _, params) = sediment_in_motion(backend, &c, seed, |_| {});
+    let (mut sim, _, params) = sediment_in_motion(backend, c, seed, |p| {
+        p.vel_rho
+            .iter_mut()
+            .for_each(|v| v[..3].iter_mut().for_each(|u| *u *= calm))
+    });
     let model = super::reference_sediment(&sim);
     assert!(model.pickup_integrated, "the case does not wear the bed");
     let dts: Vec<f32> = (0..STEPS)
@@ -350,19 +371,30 @@ pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
         .collect();
     let mut t = 0.0f64;
     let mut before = (sim.read_particles().expect("readback"), Vec::new());
-    let (mut started, mut carried, mut grew_by, mut off_by_one) = (0, 0, Vec::new(), 0);
+    let mut fluxes = vec![NO_FLUX; before.0.len()];
+    let mut wear = Wear {
+        started: 0,
+        carried: 0,
+        supplied: 0,
+    };
+    let (mut grew_by, mut off_by_one) = (Vec::new(), 0);
     for (k, &dt) in dts.iter().enumerate() {
         t += f64::from(dt);
         sim.advance_to(t).expect("steps");
         let words = sim.regions().expect("regions");
+        let (p, w) = &before;
+        let draws = Draws {
+            step: k as u32,
+            dt_s: if k > 0 { dts[k - 1] } else { 0.0 },
+        };
+        let w = if k > 0 { w.clone() } else { words.clone() };
+        let state = (p.positions.as_slice(), p.vel_rho.as_slice());
+        let oracle = rheology_pass_exner(&params, &model, state, (&w, &fluxes), Some(draws));
+        // The same pass with nothing passed on from upstream.
+        let unsupplied = vec![NO_FLUX; fluxes.len()];
+        let alone = rheology_pass_exner(&params, &model, state, (&w, &unsupplied), Some(draws));
+        fluxes = oracle.iter().map(|r| r.flux).collect();
         if k > 0 {
-            let draws = Draws {
-                step: k as u32,
-                dt_s: dts[k - 1],
-            };
-            let (p, w) = &before;
-            let oracle =
-                rheology_pass_drawn(&params, &model, &p.positions, &p.vel_rho, w, Some(draws));
             for (i, r) in oracle.iter().enumerate() {
                 let (got, want) = (words[i], r.word());
                 // The region and the hold to the bit; the worn units within one, where the
@@ -379,13 +411,16 @@ pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
                 off_by_one += usize::from(units != want_units);
                 let was = w[i] >> PICKUP_SHIFT;
                 if want_units > 0 && was == 0 {
-                    started += 1;
+                    wear.started += 1;
                 }
                 if want_units > was && was > 0 {
-                    carried += 1;
+                    wear.carried += 1;
                 }
                 if want_units > was {
                     grew_by.push(want_units - was);
+                }
+                if (alone[i].pickup).saturating_sub(r.pickup) >= 2 {
+                    wear.supplied += 1;
                 }
             }
         }
@@ -393,7 +428,10 @@ pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
     }
     let share_rounded_both_ways = grew_by.iter().min() != grew_by.iter().max();
     eprintln!(
-        "{started} grains began to wear, {carried} wore on from the step before; shares {:?} to {:?} units; {off_by_one} a unit off",
+        "{} grains began to wear, {} wore on from the step before, {} were passed bed load; shares {:?} to {:?} units; {off_by_one} a unit off",
+        wear.started,
+        wear.carried,
+        wear.supplied,
         grew_by.iter().min(),
         grew_by.iter().max()
     );
@@ -405,8 +443,29 @@ pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
         grew_by.len()
     );
     assert!(
-        started > 0 && carried > 0,
+        wear.started > 0 && wear.carried > 0,
         "nothing wore, or nothing carried over"
     );
     assert!(share_rounded_both_ways, "every share was rounded alike");
+    wear
+}
+
+/// [`check_wear`] of [`worn_away_case`].
+pub fn check_worn_away_pickup(backend: &Backend, seed: u64) {
+    check_wear(backend, &worn_away_case(), seed, 1.0);
+}
+
+/// The churning water's speeds scaled for [`check_exner_pickup`]. At their full size every
+/// grain that wears does so under a shear whose grains' step is longer than dp, so it loses its
+/// whole pick-up whatever it is passed (`Rheology::pick_up`), and no grain's wear shows what
+/// came from upstream; at 0.85 some steps are shorter. Chosen by trying 0.5, 0.7 and 0.85 (at
+/// the first two hardly a grain wears).
+const CALM: f32 = 0.85;
+
+/// [`check_wear`] of [`exner_case`], the water calmer ([`CALM`]): the bed load from upstream
+/// must cut some grain's wear by more than the comparison's unit, or a backend that ignored it
+/// would pass.
+pub fn check_exner_pickup(backend: &Backend, seed: u64) {
+    let wear = check_wear(backend, &exner_case(), seed, CALM);
+    assert!(wear.supplied > 0, "no grain was passed bed load");
 }

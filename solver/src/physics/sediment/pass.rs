@@ -19,7 +19,9 @@
 
 use super::SedimentParams;
 use super::drucker_prager::{alpha, kappa_c, yield_stress};
-use super::pickup::{PICKUP_SHIFT, integrated_pickup, picked_up, pickup_rate};
+use super::pickup::{
+    PICKUP_SHIFT, bed_load_flux, exner_pickup, integrated_pickup, picked_up, pickup_rate,
+};
 use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
     bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity, k_beta,
@@ -59,6 +61,12 @@ pub struct SedimentModel {
     /// A held particle leaves once the pick-up rate's integral has taken its mass
     /// ([`super::pickup::integrated_pickup`]), not by a chance each step.
     pub pickup_integrated: bool,
+    /// van Rijn's (1984a) saltation length per unit `T^0.9` over dp: with it, what is worn off
+    /// a held particle is net of the bed load that settles on it from upstream
+    /// (`van_rijn_exner`, [`super::pickup::exner_pickup`]); 0: the pick-up alone wears it.
+    pub exner_step_per_stage: f32,
+    /// The particle spacing, m: the held particle upstream of another lies about dp up the flow.
+    pub dp_m: f32,
 }
 
 /// The pick-up draw of a rheology pass: the run's step count (wrapping) and the last step's
@@ -84,7 +92,15 @@ pub struct ParticleRheology {
     /// The share of a held particle's mass the flow has picked up so far, in
     /// [`PICKUP_WHOLE`](super::pickup::PICKUP_WHOLE)ths (`van_rijn_integrated`; 0 otherwise).
     pub pickup: u32,
+    /// The bed load a held particle at the bed's surface passes on downstream, particles per
+    /// second (`van_rijn_exner`, [`super::pickup::bed_load_flux`]); [`NO_FLUX`] for any other.
+    /// The pass's, before any release by the stress of its neighbours (`hold.wgsl` leaves it).
+    pub flux: f32,
 }
+
+/// The flux of a particle that is not held at the bed's surface, or of a pass without
+/// deposition: no particle downstream reads it.
+pub const NO_FLUX: f32 = -1.0;
 
 /// Bit of a region word marking sediment held fixed; `REGION_HELD` of
 /// `shaders/common/sediment.wgsl` too (checked by `shaders_validate`).
@@ -419,14 +435,15 @@ impl<'a> Rheology<'a> {
 
     /// Particle i's rheology from its sums, `before` its region word after the previous pass
     /// (whether it was held, and what of it was picked up; see [`rheology_pass`]), `id` its
-    /// id (its pick-up draw's).
+    /// id (its pick-up draw's), `upstream` the bed load the held particle upstream of it passes
+    /// on ([`Upstream`]; 0 with none).
     pub fn finish(
         &self,
         x_i: &[f32; 4],
         v_i: &[f32; 4],
         s: &RheologySums,
-        before: u32,
-        id: u32,
+        (before, id): (u32, u32),
+        upstream: f32,
     ) -> ParticleRheology {
         let params = self.params;
         let phase_i = &params.phases[phase_index(x_i)];
@@ -437,15 +454,16 @@ impl<'a> Rheology<'a> {
                 region: 0,
                 held: false,
                 pickup: 0,
+                flux: NO_FLUX,
             };
         }
         let eps = strain_rate(&s.grad, params.dim);
         let ii_d = second_invariant(&eps);
-        let (region, mu, held, pickup) = if self.is_sediment(x_i) {
-            self.classify(v_i[3], s, ii_d, (before, id))
+        let (region, mu, held, (pickup, flux)) = if self.is_sediment(x_i) {
+            self.classify(v_i[3], s, ii_d, (before, id, upstream))
         } else {
             let eddy = sps_viscosity(v_i[3], self.sps_length2, ii_d);
-            (Region::Water as u32, phase_i.mu + eddy, false, 0)
+            (Region::Water as u32, phase_i.mu + eddy, false, (0, NO_FLUX))
         };
         let mut stress = [[0.0_f32; 3]; 3];
         // Shields-only holds carry no stress, as that mode always had; Drucker-Prager holds
@@ -463,6 +481,7 @@ impl<'a> Rheology<'a> {
             region,
             held,
             pickup,
+            flux,
         }
     }
 
@@ -495,15 +514,16 @@ impl<'a> Rheology<'a> {
         chain
     }
 
-    /// Region, apparent viscosity, hold and mass picked up of a sediment particle of density
-    /// `rho_i`, of region word `before` after the last pass, of id `id`.
+    /// Region, apparent viscosity, hold, and mass picked up and bed load passed on, of a
+    /// sediment particle of density `rho_i`, of region word `before` after the last pass, of id
+    /// `id`, passed `upstream` from the held particle upstream.
     fn classify(
         &self,
         rho_i: f32,
         s: &RheologySums,
         ii_d: f32,
-        (before, id): (u32, u32),
-    ) -> (u32, f32, bool, u32) {
+        (before, id, upstream): (u32, u32, f32),
+    ) -> (u32, f32, bool, (u32, f32)) {
         let held_before = before & REGION_HELD != 0;
         let (model, mat) = (self.model, &self.model.material);
         let sed = &self.params.phases[model.sediment_phase];
@@ -520,7 +540,8 @@ impl<'a> Rheology<'a> {
             ..
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
-        let (picked_up, pickup) = self.pick_up(before >> PICKUP_SHIFT, id, tau_b, tau_bcr);
+        let stress = (tau_b, tau_bcr);
+        let (picked_up, pickup, flux) = self.pick_up(before >> PICKUP_SHIFT, id, stress, upstream);
         // The stress the particle carries, which only the Drucker-Prager mode reads.
         let sqrt_j2 = if model.shields_only {
             0.0
@@ -543,81 +564,75 @@ impl<'a> Rheology<'a> {
         let held = region == Region::Unyielded;
         // What was worn off a particle stays with it while it is held, and only then.
         let pickup = if held && held_before { pickup } else { 0 };
-        (region as u32, mu.min(model.mu_max), held, pickup)
+        let flux = if held && at_surface { flux } else { NO_FLUX };
+        (region as u32, mu.min(model.mu_max), held, (pickup, flux))
     }
 }
 
 impl Rheology<'_> {
     /// Whether particle `id`, under a bed shear stress `tau_b` against its critical `tau_bcr`,
     /// is picked up in this pass, with the mass picked up of it after the pass (`units` before;
-    /// `van_rijn_integrated`): picked up always where Shields releases at once, never in a
-    /// pass without draws.
-    fn pick_up(&self, units: u32, id: u32, tau_b: f32, tau_bcr: f32) -> (bool, u32) {
+    /// `van_rijn_integrated`, and net of the bed load `upstream` passes on under
+    /// `van_rijn_exner`) and the bed load it passes on: picked up always where Shields releases
+    /// at once, never in a pass without draws.
+    fn pick_up(
+        &self,
+        units: u32,
+        id: u32,
+        (tau_b, tau_bcr): (f32, f32),
+        upstream: f32,
+    ) -> (bool, u32, f32) {
         let per_s = self.model.pickup_per_s;
         if per_s == 0.0 {
-            return (true, 0);
+            return (true, 0, NO_FLUX);
         }
-        let Some(d) = self.draws else {
-            return (false, units);
-        };
         let rate = pickup_rate(per_s, tau_b, tau_bcr);
-        if self.model.pickup_integrated {
-            match integrated_pickup(units, id, d.step, rate, d.dt_s) {
-                Some(units) => (false, units),
-                None => (true, 0),
-            }
+        let step = self.model.exner_step_per_stage;
+        let flux = if step > 0.0 {
+            bed_load_flux(rate, step, tau_b, tau_bcr)
         } else {
-            (picked_up(id, d.step, rate, d.dt_s), 0)
+            NO_FLUX
+        };
+        let Some(d) = self.draws else {
+            return (false, units, flux);
+        };
+        let worn = if step > 0.0 {
+            // E - D with D >= 0: a particle loses at most what is picked up from it, though
+            // its grains' step be longer than dp and nothing come from upstream.
+            exner_pickup(units, id, d.step, (flux - upstream).min(rate), d.dt_s)
+        } else if self.model.pickup_integrated {
+            integrated_pickup(units, id, d.step, rate, d.dt_s)
+        } else {
+            return (picked_up(id, d.step, rate, d.dt_s), 0, NO_FLUX);
+        };
+        match worn {
+            Some(units) => (false, units, flux),
+            None => (true, 0, NO_FLUX),
         }
+    }
+
+    /// Where the held particle upstream of sediment particle `x_i` lies, when what is worn off
+    /// it is net of what settles on it (`van_rijn_exner`): dp up the flow of the water nearest
+    /// it, from its sums `s`, if it was held (`before` its word) and lies at the bed's surface.
+    pub fn upstream_of(&self, x_i: &[f32; 4], s: &RheologySums, before: u32) -> Option<Upstream> {
+        let dp = self.model.dp_m;
+        let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
+        let speed = norm3(s.water_u);
+        let wears = self.model.exner_step_per_stage > 0.0 && before & REGION_HELD != 0;
+        (wears && at_surface && speed > 0.0 && self.is_sediment(x_i)).then(|| Upstream {
+            at: std::array::from_fn(|k| x_i[k] - dp * s.water_u[k] / speed),
+            from: [x_i[0], x_i[1], x_i[2]],
+            d2: dp * dp,
+            flux: 0.0,
+        })
     }
 }
 
-/// The rheology of every particle (see the module doc), `held_before[i]` whether particle i was
-/// held after the previous pass; a pass without pick-up draws (particle i's id is i). In the
-/// Drucker-Prager mode a particle held before stays held unless Shields makes it bed load: only
-/// [`super::hold::release_pass`], which follows this pass, releases it by the stress of its
-/// neighbours.
-///
-/// Panics if the slices differ in length or a phase index is outside `params.phases` (bugs of
-/// the caller).
-pub fn rheology_pass(
-    params: &Params,
-    model: &SedimentModel,
-    pos: &[[f32; 4]],
-    vel_rho: &[[f32; 4]],
-    held_before: &[bool],
-) -> Vec<ParticleRheology> {
-    let words: Vec<u32> = held_before
-        .iter()
-        .map(|&h| if h { REGION_HELD } else { 0 })
-        .collect();
-    rheology_pass_drawn(params, model, pos, vel_rho, &words, None)
-}
+mod oracle;
+mod upstream;
 
-/// [`rheology_pass`] from each particle's region word after the previous pass (its hold and,
-/// under `van_rijn_integrated`, the mass picked up of it so far), with the pass's pick-up
-/// `draws`, as the first pass of a step takes them.
-pub fn rheology_pass_drawn(
-    params: &Params,
-    model: &SedimentModel,
-    pos: &[[f32; 4]],
-    vel_rho: &[[f32; 4]],
-    words_before: &[u32],
-    draws: Option<Draws>,
-) -> Vec<ParticleRheology> {
-    assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
-    assert_eq!(pos.len(), words_before.len(), "positions and words differ");
-    let pass = Rheology::new(params, model).with_draws(draws);
-    (0..pos.len())
-        .map(|i| {
-            let mut s = pass.start(&pos[i], &vel_rho[i]);
-            for j in 0..pos.len() {
-                pass.add_pair((&pos[i], &vel_rho[i]), (&pos[j], &vel_rho[j]), &mut s);
-            }
-            pass.finish(&pos[i], &vel_rho[i], &s, words_before[i], i as u32)
-        })
-        .collect()
-}
+pub use oracle::{rheology_pass, rheology_pass_drawn, rheology_pass_exner};
+pub use upstream::Upstream;
 
 #[cfg(test)]
 mod tests;

@@ -3,6 +3,7 @@
 use super::*;
 
 use crate::physics::Phase;
+use crate::physics::sediment::pickup::PICKUP_WHOLE;
 
 const DEG: f32 = std::f32::consts::PI / 180.0;
 
@@ -95,6 +96,8 @@ fn flume_case() -> (Params, SedimentModel) {
         mu_max: 50.0,
         pickup_per_s: 0.0,
         pickup_integrated: false,
+        exner_step_per_stage: 0.0,
+        dp_m: 0.01,
     };
     (params, model)
 }
@@ -209,4 +212,165 @@ fn skeleton_pressure_is_effective_stress_at_the_surface() {
     // = 1329.255 Pa; effective stress (rho_s - rho_w) g d = 1710 * 9.81 * 0.05 = 838.755 Pa.
     let p = skeleton_pressure(1329.255, 2710.0, 1000.0);
     assert!((p - 838.755).abs() < 1e-2, "{p}");
+}
+
+/// A flat bed of 13 x 5 held sand particles (x from -6 dp to 6 dp, its top at y = 0) under a
+/// row of water dp over it flowing at 0.5 m/s along +x, worn by van Rijn's pick-up
+/// (`van_rijn_exner` with `exner`, else `van_rijn_integrated`): positions, velocities, and
+/// the region words of a bed held with `worn` of each particle worn off.
+fn worn_bed(exner: bool, worn: u32) -> (SedimentModel, Vec<[f32; 4]>, Vec<[f32; 4]>, Words) {
+    use crate::physics::sediment::pickup::{pickup_per_s, saltation_length_per_stage};
+    let dp = 0.01;
+    let mat = crate::physics::sediment::flume_sand();
+    let (rho_s, rho_w, nu_w) = (f64::from(mat.rho_s), f64::from(mat.rho_w), 1e-6);
+    let d50 = f64::from(mat.d50_m);
+    let model = SedimentModel {
+        water_speed: true,
+        pickup_per_s: pickup_per_s(d50, rho_s, rho_w, nu_w, 9.81, dp) as f32,
+        pickup_integrated: true,
+        exner_step_per_stage: if exner {
+            (saltation_length_per_stage(d50, rho_s, rho_w, nu_w, 9.81) / dp) as f32
+        } else {
+            0.0
+        },
+        ..flume_case().1
+    };
+    let at = |col: i32, y: f32, phase: u32| [col as f32 * 0.01, y, 0.0, f32::from_bits(phase)];
+    let (mut pos, mut vel, mut words) = (Vec::new(), Vec::new(), Vec::new());
+    for row in 0..5 {
+        for col in -6..=6 {
+            pos.push(at(col, -(row as f32) * 0.01, 2));
+            vel.push([0.0, 0.0, 0.0, 2710.0]);
+            words.push(Region::Unyielded as u32 | REGION_HELD | worn << PICKUP_SHIFT);
+        }
+    }
+    for col in -6..=6 {
+        pos.push(at(col, 0.01, 1));
+        vel.push([0.5, 0.0, 0.0, 1000.0]);
+        words.push(Region::Water as u32);
+    }
+    (model, pos, vel, words)
+}
+
+/// Region words, one a particle.
+type Words = Vec<u32>;
+
+/// The top row's column `col` in [`worn_bed`]'s order.
+fn top(col: i32) -> usize {
+    (col + 6) as usize
+}
+
+/// One pass of a second over [`worn_bed`] (the step's share then its whole second's), from
+/// the words and fluxes before: what each particle gives.
+fn wear_for_a_second(
+    model: &SedimentModel,
+    (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+    (words, fluxes): (&[u32], &[f32]),
+) -> Vec<ParticleRheology> {
+    let params = flume_case().0;
+    let draws = Some(Draws { step: 1, dt_s: 1.0 });
+    rheology_pass_exner(&params, model, (pos, vel), (words, fluxes), draws)
+}
+
+#[test]
+fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_upstream() {
+    let (model, pos, vel, words) = worn_bed(true, 0);
+    let none = vec![NO_FLUX; pos.len()];
+    // The first pass passes on each top particle's bed load; nothing is held beneath the top
+    // row's or in the water.
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
+    let q = first[top(0)].flux;
+    // By hand: z = dp, 0.5 m/s give u* = 0.037546 m/s and tau_b = 1.4097 Pa (the test above);
+    // Re* = 0.037546 x 4e-4 / 1e-6 = 15.018, Eq. 17 theta_cr = 0.010595 ln 15.018 + 0.110476 /
+    // 15.018 + 0.0027197 = 0.038781, tau_bcr = 0.038781 x 1710 x 9.81 x 4e-4 = 0.26022 Pa on
+    // the flat bed, T = 4.4174; the rate 5.432e-3 T^1.5 per second (pickup.rs), the step
+    // 3 d50 D*^0.6 T^0.9 / dp = 0.48456 T^0.9 particles (D* = 10.2396): 0.09305 per second.
+    let chain_t = 1.4097 / 0.26022 - 1.0_f64;
+    let by_hand = 0.09305;
+    assert!((5.432e-3 * chain_t.powf(1.5) * 0.48456 * chain_t.powf(0.9) - by_hand).abs() < 1e-4);
+    assert!(
+        (f64::from(q) / by_hand - 1.0).abs() < 0.05,
+        "{q} against {by_hand}"
+    );
+    // The bed's end faces are surface too; its middle's buried particles are not.
+    for row in 1..5 {
+        for col in -3..=3 {
+            let k = top(col) + 13 * row;
+            assert_eq!(first[k].flux, NO_FLUX, "buried particle {k}");
+        }
+    }
+    for (k, water) in first.iter().enumerate().skip(65) {
+        assert_eq!(water.flux, NO_FLUX, "water particle {k}");
+    }
+    // Passed its upstream neighbour's load, a top particle of the bed's middle loses what it
+    // passes on less what it is passed: nothing to a unit in 2^23. The bed's first column,
+    // passed nothing and under a weaker shear at the bed's end, loses what it passes on.
+    let fluxes: Vec<f32> = first.iter().map(|r| r.flux).collect();
+    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    for col in -1..=2 {
+        let r = &second[top(col)];
+        assert!(r.held && r.pickup <= 2, "column {col}: {r:?}");
+    }
+    let first_col = &second[top(-6)];
+    let own = first_col.flux * PICKUP_WHOLE as f32;
+    assert!(
+        (first_col.pickup as f32 - own).abs() <= 1.0,
+        "{first_col:?}"
+    );
+    // Worn by the pick-up alone, the middle loses as much as the first particle.
+    let (gross, pos, vel, words) = worn_bed(false, 0);
+    let alone = wear_for_a_second(&gross, (&pos, &vel), (&words, &none));
+    let rate = f64::from(alone[top(0)].pickup) / f64::from(PICKUP_WHOLE);
+    assert!(
+        (rate / (5.432e-3 * chain_t.powf(1.5)) - 1.0).abs() < 0.05,
+        "{rate}"
+    );
+    // Passed nothing (column -1 made to pass none on), column 0 loses what is picked up from
+    // it and no more: its grains' step, 0.48456 x 4.4174^0.9 = 1.84 dp, is longer than the
+    // particle, so what it passes on is 1.84 times its pick-up, and E - D with D >= 0 cannot
+    // exceed E.
+    let mut starved = fluxes.clone();
+    starved[top(-1)] = 0.0;
+    let (model, pos, vel, words) = worn_bed(true, 0);
+    let third = wear_for_a_second(&model, (&pos, &vel), (&words, &starved));
+    assert_eq!(
+        third[top(0)].pickup,
+        alone[top(0)].pickup,
+        "{:?}",
+        third[top(0)]
+    );
+    assert!(
+        third[top(0)].flux > 1.8 * rate as f32,
+        "{:?}",
+        third[top(0)]
+    );
+}
+
+#[test]
+fn bed_load_from_upstream_fills_what_was_worn_and_no_more() {
+    let half = PICKUP_WHOLE / 2;
+    let (model, pos, vel, words) = worn_bed(true, half);
+    let none = vec![NO_FLUX; pos.len()];
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
+    let mut fluxes: Vec<f32> = first.iter().map(|r| r.flux).collect();
+    // Column -1 passed on twice its load: column 0, downstream of it, is filled by its own.
+    let q = fluxes[top(0)];
+    fluxes[top(-1)] = 2.0 * q;
+    // The particle under column 2, given five times the load, lies dp farther from the point
+    // upstream of column 3 than column 2 itself: column 3 is passed column 2's.
+    fluxes[top(2) + 13] = 5.0 * q;
+    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    let filled = second[top(0)].pickup as f32;
+    let want = half as f32 - q * PICKUP_WHOLE as f32;
+    assert!((filled - want).abs() <= 1.0, "{filled} against {want}");
+    assert!(
+        second[top(3)].pickup.abs_diff(half) <= 2,
+        "{:?}",
+        second[top(3)]
+    );
+    // Passed more than was worn off it, a particle is whole again, not more.
+    let (model, pos, vel, words) = worn_bed(true, 100);
+    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    assert_eq!(second[top(0)].pickup, 0, "{:?}", second[top(0)]);
+    assert!(second[top(0)].held);
 }
