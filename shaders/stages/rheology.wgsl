@@ -109,7 +109,8 @@ fn flux_slot(step: u32) -> u32 {
 // surface, the one nearest the point dp up the flow of the nearest water, within dp of it.
 fn upstream_flux(pos_i: vec3<f32>, g: Gathered, slot: u32) -> f32 {
     let dp = params.sediment.dp;
-    let at = pos_i - dp * g.nearest_u / length(g.nearest_u);
+    let along = g.nearest_u / length(g.nearest_u);
+    let at = pos_i - dp * along;
     var best_d2 = dp * dp;
     var best = 0.0;
     let cell = cell_coords(pos_i);
@@ -212,7 +213,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
         textureStore(stress_a, texel(i), vec4<f32>(0.0));
         textureStore(stress_b, texel(i), vec4<f32>(0.0));
         regions[ids[i]] = 0u;
-        if (BEFORE_DT) {
+        if (BEFORE_DT && params.sediment.exner_step_per_stage > 0.0) {
             regions[flux_slot(state.run_steps + state.steps) + ids[i]] = bitcast<u32>(NO_FLUX);
         }
         return;
@@ -262,7 +263,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     // different order.
     regions[ids[i]] = word | (pickup << PICKUP_SHIFT);
     // The pass that wears the bed passes its bed load on to the next one's.
-    if (BEFORE_DT) {
+    if (BEFORE_DT && sd.exner_step_per_stage > 0.0) {
         regions[flux_slot(state.run_steps + state.steps) + ids[i]] = bitcast<u32>(flux);
     }
 }

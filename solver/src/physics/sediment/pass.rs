@@ -491,7 +491,7 @@ impl<'a> Rheology<'a> {
     /// value on the local slope (infinite away from the surface, where Shields does not apply).
     pub fn shields_chain(&self, s: &RheologySums) -> ShieldsChain {
         let mat = &self.model.material;
-        let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
+        let at_surface = self.at_surface(s);
         let speed = norm3(s.water_u);
         let mut chain = ShieldsChain {
             at_surface,
@@ -613,18 +613,23 @@ impl Rheology<'_> {
 
     /// Where the held particle upstream of sediment particle `x_i` lies, when what is worn off
     /// it is net of what settles on it (`van_rijn_exner`): dp up the flow of the water nearest
-    /// it, from its sums `s`, if it was held (`before` its word) and lies at the bed's surface.
+    /// it, from its sums `s`, if it was held (`before` its word) and lies at the bed's surface,
+    /// in a pass that wears the bed (one with draws; another would not read it).
     pub fn upstream_of(&self, x_i: &[f32; 4], s: &RheologySums, before: u32) -> Option<Upstream> {
-        let dp = self.model.dp_m;
-        let at_surface = s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass;
         let speed = norm3(s.water_u);
-        let wears = self.model.exner_step_per_stage > 0.0 && before & REGION_HELD != 0;
-        (wears && at_surface && speed > 0.0 && self.is_sediment(x_i)).then(|| Upstream {
-            at: std::array::from_fn(|k| x_i[k] - dp * s.water_u[k] / speed),
-            from: [x_i[0], x_i[1], x_i[2]],
-            d2: dp * dp,
-            flux: 0.0,
+        let wears = self.model.exner_step_per_stage > 0.0
+            && self.draws.is_some()
+            && before & REGION_HELD != 0;
+        (wears && self.at_surface(s) && speed > 0.0 && self.is_sediment(x_i)).then(|| {
+            let along = std::array::from_fn(|k| s.water_u[k] / speed);
+            Upstream::new([x_i[0], x_i[1], x_i[2]], along, self.model.dp_m)
         })
+    }
+
+    /// Eq. 26: a water particle within the support and a kernel mass of sediment below the
+    /// surface fraction of a particle's.
+    fn at_surface(&self, s: &RheologySums) -> bool {
+        s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass
     }
 }
 
