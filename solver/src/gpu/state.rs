@@ -69,7 +69,7 @@ impl StateTextures {
     }
 }
 
-/// Bytes of one vec4<f32> particle attribute (positions, velocity-density, forces).
+/// Bytes of one `vec4<f32>` particle attribute (positions, velocity-density, forces).
 pub const VEC4_BYTES: u64 = 16;
 
 /// The runs of one word per particle in `GpuBuffers::regions`: words and two steps' fluxes.

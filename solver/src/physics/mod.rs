@@ -3,7 +3,7 @@
 //!
 //! Everything here is plain f32 arithmetic over slices, written to be read as a spec: it is the
 //! oracle the GPU shaders are tested against, so it follows the same formulas (not necessarily the
-//! same summation order). The pair formulas are written over [`lanes::Real`], so that the CPU
+//! same summation order). The pair formulas are written over [`lanes::Real`](crate::physics::lanes::Real), so that the CPU
 //! backend runs the very same code on eight particles at once.
 //!
 //! Particle layout shared with the GPU:

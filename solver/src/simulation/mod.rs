@@ -2,7 +2,7 @@
 //!
 //! Absolute time is kept here in f64; the GPU only sees the time since the start of the
 //! current chunk (f32 cannot resolve dt = 1e-5 s at t = 3600 s). The inlet (discharges, their
-//! schedule, the particles it places) is in [`inflow`].
+//! schedule, the particles it places) is in `inflow`.
 
 mod chain;
 mod inflow;

@@ -69,7 +69,7 @@ pub struct Side<L: Real = f32> {
     pub rho0: L,
     pub mass: L,
     pub mu: L,
-    /// `rho0 g / B` of the phase, 1/m (see [`PhaseConsts::hydro`]).
+    /// `rho0 g / B` of the phase, 1/m (see `PhaseConsts::hydro`).
     pub hydro: L,
     /// Moved at an imposed velocity (an inlet buffer): its density is not the flow's, and a
     /// wall under the generalised condition does not count it (`physics::boundary`).

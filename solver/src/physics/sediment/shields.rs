@@ -176,7 +176,7 @@ pub struct FrictionVelocity {
 /// 2. otherwise the log law on the smooth, transitional and rough ranges of u* above the
 ///    sub-layer, each continuous and increasing where positive: on the smooth and transitional
 ///    ranges the bracket is narrowed to four f32 ulps by Newton's method from its top, a step
-///    that leaves the bracket being a bisection instead ([`narrow_bracket`]); on the rough one
+///    that leaves the bracket being a bisection instead (`narrow_bracket`); on the rough one
 ///    the closed form `u* = kappa u / ln(z / 0.033 ks)`.
 ///
 /// Reading the paper's iteration ("start from smooth flow inside the sub-layer, iterate until u*
