@@ -17,6 +17,8 @@
 
 use crate::config::Case;
 use crate::particles::{ParticleRegion, Particles};
+use crate::physics::sediment::pass::REGION_HELD;
+use crate::physics::sediment::pickup::{PICKUP_SHIFT, PICKUP_WHOLE};
 use crate::physics::sediment::suspension::Region;
 
 /// Equal stretches of the bed, by where its grains started, that the budget counts apart.
@@ -44,6 +46,16 @@ pub struct BudgetRow {
     pub furthest_m: f64,
     /// Mobilised grains by the stretch they started in, upstream first ([`SedimentBudget::stretch_edges_m`]).
     pub mobilised_by_stretch: [u64; STRETCHES],
+    /// The mass the flow has worn off grains it still holds, in grains: none of the counts
+    /// above sees it, for no grain has left. Under `van_rijn_exner` a held grain loses what
+    /// it passes downstream less what it is passed, so along the bed's top row the losses add
+    /// up to the bed load passed over the row's last held grain, less what the bound of
+    /// `exner_pickup` (no grain loses more than its pick-up) kept on the bed: sand gone to
+    /// the collector that it has not counted. Under `van_rijn_integrated` it is what was
+    /// picked up off grains not yet released.
+    pub worn: f64,
+    /// [`BudgetRow::worn`] by the stretch the worn grains started in, upstream first.
+    pub worn_by_stretch: [f64; STRETCHES],
 }
 
 /// One grain's history.
@@ -140,17 +152,23 @@ impl SedimentBudget {
             travelled_far: 0,
             furthest_m: 0.0,
             mobilised_by_stretch: [0; STRETCHES],
+            worn: 0.0,
+            worn_by_stretch: [0.0; STRETCHES],
         };
+        let mut worn_units = [0u64; STRETCHES];
         let (sand_phase, dp, past_bed_x) = (self.sand_phase, self.dp, self.past_bed_x_m);
+        let edges = self.edges_m;
         for g in &mut self.grains {
             let is_sand = g.id < particles.len() && particles.phase(g.id) == sand_phase;
             let place = if is_sand {
                 let p = particles.positions[g.id];
                 let (x, y) = (f64::from(p[0]), f64::from(p[1]));
                 g.last_x = x;
-                let region = regions
-                    .get(g.id)
-                    .and_then(|&w| ParticleRegion::from_word(w).region);
+                let word = regions.get(g.id).copied().unwrap_or(0);
+                if word & REGION_HELD != 0 {
+                    worn_units[stretch(&edges, g.start[0])] += u64::from(word >> PICKUP_SHIFT);
+                }
+                let region = ParticleRegion::from_word(word).region;
                 let shifted = (x - g.start[0]).hypot(y - g.start[1]) > 0.5 * dp;
                 let yielded = matches!(
                     region,
@@ -186,14 +204,21 @@ impl SedimentBudget {
                 row.travelled_far += 1;
             }
             row.furthest_m = row.furthest_m.max(travel);
-            let k = self.edges_m[1..STRETCHES]
-                .iter()
-                .take_while(|&&e| g.start[0] >= e)
-                .count();
-            row.mobilised_by_stretch[k] += 1;
+            row.mobilised_by_stretch[stretch(&edges, g.start[0])] += 1;
         }
+        let whole = f64::from(PICKUP_WHOLE);
+        row.worn_by_stretch = worn_units.map(|u| u as f64 / whole);
+        row.worn = worn_units.iter().sum::<u64>() as f64 / whole;
         row
     }
+}
+
+/// The stretch between `edges_m` that a grain which started at `x` m along the flume belongs to.
+fn stretch(edges_m: &[f64; STRETCHES + 1], x: f64) -> usize {
+    edges_m[1..STRETCHES]
+        .iter()
+        .take_while(|&&e| x >= e)
+        .count()
 }
 
 /// Where a mobilised grain is at an output.

@@ -178,8 +178,9 @@ impl<W: Write> ErodedMassCsv<W> {
 }
 
 /// sediment_budget.csv: where the sand the flow has moved is at each output, in grains
-/// (`flume_solver::budget`), and the grains mobilised from each stretch of the bed, the
-/// stretch named by its bounds along the flume.
+/// (`flume_solver::budget`), the mass worn off grains still held (`worn`, in grains), and the
+/// grains mobilised and the mass worn from each stretch of the bed, the stretch named by its
+/// bounds along the flume.
 pub struct BudgetCsv<W: Write> {
     w: W,
 }
@@ -188,16 +189,19 @@ impl<W: Write> BudgetCsv<W> {
     pub fn new(mut w: W, edges_m: &[f64; STRETCHES + 1]) -> io::Result<Self> {
         let mut header = String::from(
             "time_s,mobilised,moving,suspended,deposited,past_bed,collected,excluded,\
-             travelled_far,furthest_m",
+             travelled_far,furthest_m,worn",
         );
-        for k in 0..STRETCHES {
-            // Three decimals tell the stretches of any flume apart (each is at least a dp wide).
-            let _ = write!(
-                header,
-                ",mobilised_from_{:.3}_{:.3}_m",
-                edges_m[k],
-                edges_m[k + 1]
-            );
+        for what in ["mobilised", "worn"] {
+            for k in 0..STRETCHES {
+                // Three decimals tell the stretches of any flume apart (each is at least a dp
+                // wide).
+                let _ = write!(
+                    header,
+                    ",{what}_from_{:.3}_{:.3}_m",
+                    edges_m[k],
+                    edges_m[k + 1]
+                );
+            }
         }
         writeln!(w, "{header}")?;
         w.flush()?;
@@ -205,10 +209,12 @@ impl<W: Write> BudgetCsv<W> {
     }
 
     pub fn row(&mut self, r: &BudgetRow) -> io::Result<()> {
-        let stretches: Vec<String> = r.mobilised_by_stretch.iter().map(u64::to_string).collect();
+        let stretches: Vec<String> = (r.mobilised_by_stretch.iter().map(u64::to_string))
+            .chain(r.worn_by_stretch.iter().map(|w| format!("{w:.6}")))
+            .collect();
         writeln!(
             self.w,
-            "{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{:.6},{}",
             r.time_s,
             r.mobilised,
             r.moving,
@@ -219,6 +225,7 @@ impl<W: Write> BudgetCsv<W> {
             r.excluded,
             r.travelled_far,
             r.furthest_m,
+            r.worn,
             stretches.join(",")
         )?;
         self.w.flush()
