@@ -49,10 +49,10 @@ pub struct BudgetRow {
     /// The mass the flow has worn off grains it still holds, in grains: none of the counts
     /// above sees it, for no grain has left. Under `van_rijn_exner` a held grain loses what
     /// it passes downstream less what it is passed, so along the bed's top row the losses add
-    /// up to the bed load passed over the row's last held grain, less what the bound of
-    /// `exner_pickup` (no grain loses more than its pick-up) kept on the bed: sand gone to
-    /// the collector that it has not counted. Under `van_rijn_integrated` it is what was
-    /// picked up off grains not yet released.
+    /// up to the bed load passed over the row's last held grain into the pit, less what the
+    /// bound of `exner_pickup` (no grain loses more than its pick-up) kept on the bed, plus
+    /// the load passed to grains with nothing worn off to fill (which nothing takes up). Under
+    /// `van_rijn_integrated` it is what was picked up off grains not yet released.
     pub worn: f64,
     /// [`BudgetRow::worn`] by the stretch the worn grains started in, upstream first.
     pub worn_by_stretch: [f64; STRETCHES],

@@ -18,7 +18,9 @@ const LINES: [Line; 7] = [
     ("mobilised", RGBColor(0, 0, 0), |r| r.mobilised as f64),
     ("moving", RGBColor(200, 80, 40), |r| r.moving as f64),
     ("suspended", RGBColor(130, 60, 160), |r| r.suspended as f64),
-    ("deposited again", RGBColor(40, 150, 70), |r| r.deposited as f64),
+    ("deposited again", RGBColor(40, 150, 70), |r| {
+        r.deposited as f64
+    }),
     ("past the bed", RGBColor(0, 160, 190), |r| r.past_bed as f64),
     ("collected", RGBColor(170, 110, 40), |r| r.collected as f64),
     ("worn off held grains", RGBColor(150, 150, 150), |r| r.worn),
