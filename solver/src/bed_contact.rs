@@ -4,18 +4,20 @@
 //!
 //! In every 10 cm column from x = 0.3 to 2.1 m:
 //! - the bed's top particle: the highest held sand particle, or, for a bed that is a wall block
-//!   (clear water), the highest wall particle below [`BED_BELOW_M`](crate::bed_contact::BED_BELOW_M);
+//!   (clear water), the highest wall particle below
+//!   [`BED_BELOW_M`](crate::bed_contact::BED_BELOW_M);
 //! - the gap: the 5th percentile of the water particles' heights above it, in dp (about 1 for
 //!   water on a boundary's face, half a dp above its outermost particles);
 //! - the held sand's push: its Tait pressure over the weight of the water above it
 //!   (`rho_w g (surface - y_top)`, the surface half a dp over the highest water particle).
 //!
-//! The momentum equation (Eq. 10) weighs a neighbour's pressure by `m_j / rho_j^2 = V_j /
-//! rho_j`: water feels sand of Tait pressure p as water of pressure `p rho_w / rho_s`, and at
-//! equal compression sand's Tait pressure is `rho_s / rho_w` times water's. So the load the bed
-//! carries, as the water feels it, is the Tait ratio times `rho_w / rho_s`
-//! ([`BedContact::felt_over_load`](crate::bed_contact::BedContact::felt_over_load)). A held bed that stands as a wall (`physics::boundary`) is
-//! felt as walls are, at its own pressure: the ratio itself.
+//! The momentum equation (Eq. 10) weighs a neighbour's pressure by `m_j / rho_j^2 = V_j / rho_j`:
+//! water feels sand of Tait pressure p as water of pressure `p rho_w / rho_s`, and at equal
+//! compression sand's Tait pressure is `rho_s / rho_w` times water's. So the load the bed carries,
+//! as the water feels it, is the Tait ratio times `rho_w / rho_s`
+//! ([`BedContact::felt_over_load`](crate::bed_contact::BedContact::felt_over_load)). A held bed
+//! that stands as a wall (`physics::boundary`) is felt as walls are, at its own pressure: the ratio
+//! itself.
 
 use crate::config::Case;
 use crate::derived::{Derived, tait_b};

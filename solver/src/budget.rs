@@ -17,8 +17,7 @@
 
 use crate::config::Case;
 use crate::particles::{ParticleRegion, Particles};
-use crate::physics::sediment::pass::REGION_HELD;
-use crate::physics::sediment::pickup::{PICKUP_SHIFT, PICKUP_WHOLE};
+use crate::physics::sediment::pickup::PICKUP_WHOLE;
 use crate::physics::sediment::suspension::Region;
 
 /// Equal stretches of the bed, by where its grains started, that the budget counts apart.
@@ -164,11 +163,9 @@ impl SedimentBudget {
                 let p = particles.positions[g.id];
                 let (x, y) = (f64::from(p[0]), f64::from(p[1]));
                 g.last_x = x;
-                let word = regions.get(g.id).copied().unwrap_or(0);
-                if word & REGION_HELD != 0 {
-                    worn_units[stretch(&edges, g.start[0])] += u64::from(word >> PICKUP_SHIFT);
-                }
-                let region = ParticleRegion::from_word(word).region;
+                let decoded = ParticleRegion::from_word(regions.get(g.id).copied().unwrap_or(0));
+                worn_units[stretch(&edges, g.start[0])] += u64::from(decoded.worn_units);
+                let region = decoded.region;
                 let shifted = (x - g.start[0]).hypot(y - g.start[1]) > 0.5 * dp;
                 let yielded = matches!(
                     region,

@@ -9,28 +9,30 @@
 //!
 //! The flume, from downstream up (the ULBRA case's layout):
 //! - **The weir** at the downstream end: a rectangular-profile crest of height P above the
-//!   collector pit's floor and of length L in the flow direction, with a free overfall. Its
-//!   rating gives the pool's level, crest + H, for the unit discharge q ([`Weir::head_m`](crate::hydraulics::Weir::head_m)):
-//!   at the model's dp the end wall's particle layers make a crest as long as the head is
-//!   high, a short-crested weir, rated as such ([`crest_coefficient`](crate::hydraulics::crest_coefficient)).
-//! - **The collector pit** between the end of the bed and the weir. The flow leaves the bed
-//!   into it over an abrupt drop. In a pit longer than the reattachment length behind such a
-//!   step it spreads down and slows before the weir, losing the Borda-Carnot head
-//!   `(V1 - V2)^2 / 2g` of an abrupt expansion (Chow 1959, Open-Channel Hydraulics): the level
-//!   over the bed's end is the pool's plus `V2 (V2 - V1) / g`. In a shorter one (the ULBRA
-//!   case's 27 cm behind a 5.5 cm step, 5 step heights against 7) the current crosses at the
-//!   crest's level and reaches the weir with its velocity head ([`PitFlow`](crate::hydraulics::PitFlow)); the geometry
-//!   chooses which ([`REATTACHMENT_STEP_HEIGHTS`](crate::hydraulics::REATTACHMENT_STEP_HEIGHTS)).
+//!   collector pit's floor and of length L in the flow direction, with a free overfall. Its rating
+//!   gives the pool's level, crest + H, for the unit discharge q
+//!   ([`Weir::head_m`](crate::hydraulics::Weir::head_m)): at the model's dp the end wall's particle
+//!   layers make a crest as long as the head is high, a short-crested weir, rated as such
+//!   ([`crest_coefficient`](crate::hydraulics::crest_coefficient)).
+//! - **The collector pit** between the end of the bed and the weir. The flow leaves the bed into it
+//!   over an abrupt drop. In a pit longer than the reattachment length behind such a step it
+//!   spreads down and slows before the weir, losing the Borda-Carnot head `(V1 - V2)^2 / 2g` of an
+//!   abrupt expansion (Chow 1959, Open-Channel Hydraulics): the level over the bed's end is the
+//!   pool's plus `V2 (V2 - V1) / g`. In a shorter one (the ULBRA case's 27 cm behind a 5.5 cm step,
+//!   5 step heights against 7) the current crosses at the crest's level and reaches the weir with
+//!   its velocity head ([`PitFlow`](crate::hydraulics::PitFlow)); the geometry chooses which
+//!   ([`REATTACHMENT_STEP_HEIGHTS`](crate::hydraulics::REATTACHMENT_STEP_HEIGHTS)).
 //! - **The bed**, horizontal, with the gradually varied flow `dh/dx = (S0 - Sf) / (1 - Fr^2)`
 //!   (Chow 1959) integrated upstream from the bed's end, S0 = 0. The friction slope is
 //!   Manning's, `Sf = n^2 V^2 / R^(4/3)`, with Strickler's `n = ks^(1/6) / 21.1` (Strickler
 //!   1923; ks in m) for the sand's roughness ks.
 //!
 //! Side walls: a 2-D model has none, so the reference it is checked against takes the bed's
-//! friction alone (`R = h`, per metre of width): [`SideWalls::None`](crate::hydraulics::SideWalls::None). The real flume's glass
-//! walls add friction; [`SideWalls::Glass`](crate::hydraulics::SideWalls::Glass) gives it by the Horton-Einstein composite roughness
-//! (Chow 1959) over the wetted perimeter `b + 2h`, to say how much a 2-D twin must
-//! miss by without a wall-shear term of its own.
+//! friction alone (`R = h`, per metre of width):
+//! [`SideWalls::None`](crate::hydraulics::SideWalls::None). The real flume's glass walls add
+//! friction; [`SideWalls::Glass`](crate::hydraulics::SideWalls::Glass) gives it by the
+//! Horton-Einstein composite roughness (Chow 1959) over the wetted perimeter `b + 2h`, to say how
+//! much a 2-D twin must miss by without a wall-shear term of its own.
 
 use crate::config::Case;
 use crate::physics::sediment::shields::KARMAN;

@@ -4,6 +4,7 @@
 
 use crate::config::Case;
 use crate::physics::sediment::pass::REGION_HELD;
+use crate::physics::sediment::pickup::PICKUP_SHIFT;
 use crate::physics::sediment::suspension::Region;
 
 /// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
@@ -85,7 +86,8 @@ impl Particles {
 }
 
 /// A particle's region word (`Simulation::regions`), decoded. The backends keep the region in
-/// the word's low byte and `REGION_HELD` above it, as `shaders/common/sediment.wgsl` does.
+/// the word's low byte, `REGION_HELD` above it and a held particle's worn units above that
+/// (`PICKUP_SHIFT`), as `shaders/common/sediment.wgsl` does.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ParticleRegion {
     /// The region of Figure 2; none for walls, for every particle of a case without the
@@ -93,6 +95,9 @@ pub struct ParticleRegion {
     pub region: Option<Region>,
     /// Sediment held fixed in the last rheology pass.
     pub held: bool,
+    /// The share of a held particle's mass a pick-up worn away has taken off it, in
+    /// `PICKUP_WHOLE`ths; 0 for a particle not held.
+    pub worn_units: u32,
 }
 
 impl ParticleRegion {
@@ -105,9 +110,11 @@ impl ParticleRegion {
             5 => Some(Region::Water),
             _ => None,
         };
+        let held = word & REGION_HELD != 0;
         ParticleRegion {
             region,
-            held: word & REGION_HELD != 0,
+            held,
+            worn_units: if held { word >> PICKUP_SHIFT } else { 0 },
         }
     }
 
@@ -126,13 +133,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_region_word_is_the_region_and_the_held_bit() {
-        let held_unyielded = ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD);
+    fn a_region_word_is_the_region_the_held_bit_and_the_wear() {
+        let worn = 3 << PICKUP_SHIFT;
+        let held_unyielded =
+            ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD | worn);
         assert_eq!(held_unyielded.region, Some(Region::Unyielded));
         assert!(held_unyielded.held);
+        assert_eq!(held_unyielded.worn_units, 3);
         assert_eq!(held_unyielded.number(), 1);
-        let water = ParticleRegion::from_word(Region::Water as u32);
-        assert_eq!((water.number(), water.held), (5, false));
+        // Units in the word of a particle not held are no wear.
+        let water = ParticleRegion::from_word(Region::Water as u32 | worn);
+        assert_eq!(
+            (water.number(), water.held, water.worn_units),
+            (5, false, 0)
+        );
         assert_eq!(ParticleRegion::from_word(0), ParticleRegion::default());
     }
 }

@@ -100,8 +100,8 @@ fn each_grain_is_booked_where_it_is_and_stays_mobilised() {
 }
 
 /// The mass worn off grains still held, whether or not they have moved, and by the stretch
-/// the grain started in: a quarter of one untouched grain and three eighths of another; the units left in the word of a grain that is
-/// not held, and of water, are no grain's wear.
+/// the grain started in: a quarter of one untouched grain and three eighths of another; the
+/// units left in the word of a grain that is not held, and of water, are no grain's wear.
 #[test]
 fn worn_is_the_wear_of_the_held_grains() {
     use crate::physics::sediment::pickup::{PICKUP_SHIFT, PICKUP_WHOLE};

@@ -3,8 +3,9 @@
 //!
 //! Everything here is plain f32 arithmetic over slices, written to be read as a spec: it is the
 //! oracle the GPU shaders are tested against, so it follows the same formulas (not necessarily the
-//! same summation order). The pair formulas are written over [`lanes::Real`](crate::physics::lanes::Real), so that the CPU
-//! backend runs the very same code on eight particles at once.
+//! same summation order). The pair formulas are written over
+//! [`lanes::Real`](crate::physics::lanes::Real), so that the CPU backend runs the very same code on
+//! eight particles at once.
 //!
 //! Particle layout shared with the GPU:
 //! - positions are `[x, y, z, w]` with `w = f32::from_bits(phase index)`;

@@ -366,4 +366,45 @@ mod tests {
             "time_s,x_m,surface_m,water_top_m,sand_top_m\n0.5,0.25,0.1,0.1,0.04\n0.5,0.5,,,0.03\n"
         );
     }
+
+    /// Each budget figure under its own name: the worn columns follow the mobilised ones, each
+    /// stretch's value under that stretch's bounds.
+    #[test]
+    fn budget_rows_put_each_stretch_under_its_bounds() {
+        let mut buf = Vec::new();
+        let edges = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0];
+        let mut csv = BudgetCsv::new(&mut buf, &edges).unwrap();
+        csv.row(&BudgetRow {
+            time_s: 1.5,
+            mobilised: 9,
+            moving: 1,
+            suspended: 2,
+            deposited: 3,
+            past_bed: 0,
+            collected: 3,
+            excluded: 1,
+            travelled_far: 4,
+            furthest_m: 0.25,
+            mobilised_by_stretch: [5, 0, 0, 0, 4],
+            worn: 0.75,
+            worn_by_stretch: [0.5, 0.0, 0.0, 0.0, 0.25],
+        })
+        .unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        let mut lines = text.lines();
+        let names: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let values: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(names.len(), values.len(), "{text}");
+        let cell = |name: &str| {
+            let k = names.iter().position(|n| *n == name);
+            values[k.unwrap_or_else(|| panic!("no column {name} in {text}"))]
+        };
+        assert_eq!(cell("collected"), "3");
+        assert_eq!(cell("worn"), "0.750000");
+        assert_eq!(cell("mobilised_from_0.000_0.400_m"), "5");
+        assert_eq!(cell("mobilised_from_1.600_2.000_m"), "4");
+        assert_eq!(cell("worn_from_0.000_0.400_m"), "0.500000");
+        assert_eq!(cell("worn_from_1.600_2.000_m"), "0.250000");
+        assert_eq!(cell("worn_from_0.400_0.800_m"), "0.000000");
+    }
 }
