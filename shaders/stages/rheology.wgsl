@@ -94,7 +94,7 @@ fn deviatoric_strain(grad: mat3x3<f32>) -> mat3x3<f32> {
 struct Chosen {
     region: u32,
     mu: f32,
-    pickup: u32,   // the mass picked up of a held particle so far (pickup.rs)
+    pickup: i32,   // the mass picked up of a held particle so far, signed (pickup.rs)
     flux: f32,     // the bed load it passes on (pass.rs's ParticleRheology::flux)
 }
 
@@ -161,11 +161,11 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     }
     // The pass before the step's size is chosen draws the pick-ups, one draw a step.
     var picked = sd.pickup_per_s == 0.0;
-    var pickup = select(before >> PICKUP_SHIFT, 0u, picked);
+    var pickup = select(bitcast<i32>(before) >> PICKUP_SHIFT, 0, picked);
     let rate = pickup_rate(tau_b, tau_bcr);
     // Worn net of what settles from upstream: Exner's balance (`van_rijn_exner`).
     let exner = sd.exner_step_per_stage > 0.0;
-    let flux = bed_load_flux(rate, tau_b, tau_bcr);
+    var flux = bed_load_flux(rate, tau_b, tau_bcr);
     if (!picked && BEFORE_DT) {
         let step = state.run_steps + state.steps;
         if (exner) {
@@ -173,18 +173,18 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
             if (held_before && at_surface && length(g.nearest_u) > 0.0) {
                 upstream = upstream_flux(pos_i, g, flux_slot(step + 1u));
             }
-            // E - D with D >= 0: never more than what is picked up from it.
-            let net = min(flux - upstream, rate);
-            let worn = exner_pickup(pickup, ids[i], step, net, state.dt_taken);
-            picked = worn >= PICKUP_WHOLE;
-            pickup = select(worn, 0u, picked);
+            let exchange = exner_exchange(flux, upstream, rate, pickup, state.dt_taken);
+            flux = exchange.x;
+            let worn = exner_pickup(pickup, ids[i], step, exchange.y, state.dt_taken);
+            picked = worn >= i32(PICKUP_WHOLE);
+            pickup = select(worn, 0, picked);
         } else if (sd.pickup_integrated != 0u) {
-            let worn = integrated_pickup(pickup, ids[i], step, rate, state.dt_taken);
+            let worn = integrated_pickup(u32(max(pickup, 0)), ids[i], step, rate, state.dt_taken);
             picked = worn >= PICKUP_WHOLE;
-            pickup = select(worn, 0u, picked);
+            pickup = select(i32(worn), 0, picked);
         } else {
             picked = picked_up(ids[i], step, rate, state.dt_taken);
-            pickup = 0u;
+            pickup = 0;
         }
     }
     let region = sediment_region(RegionInputs(
@@ -192,7 +192,7 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
         picked
     ));
     // What was worn off a particle stays with it while it is held, and only then.
-    let kept = select(0u, pickup, region == REGION_UNYIELDED && held_before);
+    let kept = select(0, pickup, region == REGION_UNYIELDED && held_before);
     let passed = exner && !picked && region == REGION_UNYIELDED && at_surface;
     let mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
     return Chosen(region, mu, kept, select(NO_FLUX, flux, passed));
@@ -242,7 +242,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Water's own viscosity and its eddy viscosity; sediment takes its region's below.
     var mu = ph_i.mu + sps_viscosity(rho_i, ii_d);
     var region = REGION_WATER;
-    var pickup = 0u;
+    var pickup = 0;
     var flux = NO_FLUX;
     if (is_sediment) {
         let chosen = sediment_rheology(i, pos_i.xyz, rho_i, g, ii_d);
@@ -261,7 +261,7 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(stress_b, texel(i), vec4<f32>(t[2].y, t[2].z, mu, f32(word)));
     // By particle id: the integrators, the probes and the host each see the particles in a
     // different order.
-    regions[ids[i]] = word | (pickup << PICKUP_SHIFT);
+    regions[ids[i]] = word | (bitcast<u32>(pickup) << PICKUP_SHIFT);
     // The pass that wears the bed passes its bed load on to the next one's.
     if (BEFORE_DT && sd.exner_step_per_stage > 0.0) {
         regions[flux_slot(state.run_steps + state.steps) + ids[i]] = bitcast<u32>(flux);

@@ -47,11 +47,11 @@ pub struct BudgetRow {
     pub mobilised_by_stretch: [u64; STRETCHES],
     /// The mass the flow has worn off grains it still holds, in grains: none of the counts
     /// above sees it, for no grain has left. Under `van_rijn_exner` a held grain loses what
-    /// it passes downstream less what it is passed, so along the bed's top row the losses add
-    /// up to the bed load passed over the row's last held grain into the pit, less what the
-    /// bound of `exner_pickup` (no grain loses more than its pick-up) kept on the bed, plus
-    /// the load passed to grains with nothing worn off to fill (which nothing takes up). Under
-    /// `van_rijn_integrated` it is what was picked up off grains not yet released.
+    /// it passes downstream less what it is passed, and what settles on it beyond what was
+    /// worn off counts against it, so along the bed's top row the losses add up to the bed
+    /// load passed over the row's last held grain into the pit (negative by stretch where the
+    /// bed has built up). Under `van_rijn_integrated` it is what was picked up off grains not
+    /// yet released.
     pub worn: f64,
     /// [`BudgetRow::worn`] by the stretch the worn grains started in, upstream first.
     pub worn_by_stretch: [f64; STRETCHES],
@@ -154,7 +154,7 @@ impl SedimentBudget {
             worn: 0.0,
             worn_by_stretch: [0.0; STRETCHES],
         };
-        let mut worn_units = [0u64; STRETCHES];
+        let mut worn_units = [0i64; STRETCHES];
         let (sand_phase, dp, past_bed_x) = (self.sand_phase, self.dp, self.past_bed_x_m);
         let edges = self.edges_m;
         for g in &mut self.grains {
@@ -164,7 +164,7 @@ impl SedimentBudget {
                 let (x, y) = (f64::from(p[0]), f64::from(p[1]));
                 g.last_x = x;
                 let decoded = ParticleRegion::from_word(regions.get(g.id).copied().unwrap_or(0));
-                worn_units[stretch(&edges, g.start[0])] += u64::from(decoded.worn_units);
+                worn_units[stretch(&edges, g.start[0])] += i64::from(decoded.worn_units);
                 let region = decoded.region;
                 let shifted = (x - g.start[0]).hypot(y - g.start[1]) > 0.5 * dp;
                 let yielded = matches!(
@@ -205,7 +205,7 @@ impl SedimentBudget {
         }
         let whole = f64::from(PICKUP_WHOLE);
         row.worn_by_stretch = worn_units.map(|u| u as f64 / whole);
-        row.worn = worn_units.iter().sum::<u64>() as f64 / whole;
+        row.worn = worn_units.iter().sum::<i64>() as f64 / whole;
         row
     }
 }

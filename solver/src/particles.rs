@@ -4,7 +4,7 @@
 
 use crate::config::Case;
 use crate::physics::sediment::pass::REGION_HELD;
-use crate::physics::sediment::pickup::PICKUP_SHIFT;
+use crate::physics::sediment::pickup::word_units;
 use crate::physics::sediment::suspension::Region;
 
 /// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
@@ -96,8 +96,9 @@ pub struct ParticleRegion {
     /// Sediment held fixed in the last rheology pass.
     pub held: bool,
     /// The share of a held particle's mass a pick-up worn away has taken off it, in
-    /// `PICKUP_WHOLE`ths; 0 for a particle not held.
-    pub worn_units: u32,
+    /// `PICKUP_WHOLE`ths, negative where more has settled on it than was worn off it; 0 for a
+    /// particle not held.
+    pub worn_units: i32,
 }
 
 impl ParticleRegion {
@@ -114,7 +115,7 @@ impl ParticleRegion {
         ParticleRegion {
             region,
             held,
-            worn_units: if held { word >> PICKUP_SHIFT } else { 0 },
+            worn_units: if held { word_units(word) } else { 0 },
         }
     }
 
@@ -131,10 +132,14 @@ const REGION_MASK: u32 = 0xff;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::sediment::pickup::units_word;
 
     #[test]
     fn a_region_word_is_the_region_the_held_bit_and_the_wear() {
-        let worn = 3 << PICKUP_SHIFT;
+        let worn = units_word(3);
+        let built =
+            ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD | units_word(-5));
+        assert_eq!(built.worn_units, -5, "a surplus settled on a held particle");
         let held_unyielded =
             ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD | worn);
         assert_eq!(held_unyielded.region, Some(Region::Unyielded));

@@ -27,7 +27,8 @@ use flume_solver::physics::kernel::Wendland;
 use flume_solver::physics::sediment::drucker_prager::{alpha, kappa_c, yield_stress};
 use flume_solver::physics::sediment::pass::{skeleton_pressure, slope_factors};
 use flume_solver::physics::sediment::pickup::{
-    PICKUP_WHOLE, integrated_pickup, picked_up, pickup_draw, pickup_rate,
+    PICKUP_WHOLE, exner_exchange, exner_pickup, integrated_pickup, picked_up, pickup_draw,
+    pickup_rate,
 };
 use flume_solver::physics::sediment::rheology::hbp_viscosity;
 use flume_solver::physics::sediment::shields::{critical_shields, friction_velocity};
@@ -397,6 +398,7 @@ fn the_pickup() {
         "{picked}"
     );
     worn_away_alike(&p, &pairs, halves);
+    exner_alike(&p, &pairs, halves);
 }
 
 /// `integrated_pickup` of both sides, to the unit: shares of a step from none through a
@@ -405,7 +407,7 @@ fn the_pickup() {
 fn worn_away_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]) {
     let mut cases = Vec::new();
     for &(id, step) in pairs {
-        for units in [0u32, 1, 4_194_304, PICKUP_WHOLE - 1] {
+        for units in [0u32, 1, PICKUP_WHOLE / 2, PICKUP_WHOLE - 1] {
             for share in [0.0f32, 0.3 / PICKUP_WHOLE as f32, 2.7e-6, 0.25, 1.0, 3.0] {
                 let [i1, i0] = halves(id);
                 let [s1, s0] = halves(step);
@@ -452,6 +454,76 @@ fn worn_away_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32
         rounded_up > 0 && rounded_down > 0,
         "{rounded_up} / {rounded_down}"
     );
+}
+
+/// `exner_exchange` and `exner_pickup` of both sides: what a held particle passes on and keeps
+/// where it is passed nothing, less than it carries, more, and more than it has room for; and
+/// its units to the unit from a whole particle's surplus to one unit short of its loss, for
+/// losses and gains from none through a fraction of a unit to a whole particle.
+fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]) {
+    let whole = PICKUP_WHOLE as i32;
+    let mut exchanges = Vec::new();
+    for units in [-whole, 1000 - whole, -1, 0, whole / 2] {
+        for (flux, upstream, rate) in [(0.09, 0.0, 0.05), (0.09, 0.05, 0.05), (0.02, 0.5, 0.05)] {
+            for dt in [1e-4f32, 1.0] {
+                exchanges.push([[flux, upstream, rate, dt], [units as f32, 0.0, 0.0, 0.0]]);
+            }
+        }
+    }
+    p.agree_within(
+        "Exner's exchange",
+        "vec4<f32>(exner_exchange(a.x, a.y, a.z, i32(b.x), a.w), 0.0, 0.0)",
+        &exchanges,
+        2,
+        1e-6,
+        |i| {
+            let (out, net) = exner_exchange(i[0][0], i[0][1], i[0][2], i[1][0] as i32, i[0][3]);
+            [out, net, 0.0, 0.0]
+        },
+    );
+    let mut cases = Vec::new();
+    for &(id, step) in pairs {
+        for units in [-whole, 5 - whole, -1, 0, 1, whole / 2, whole - 1] {
+            for net in [
+                0.0f32,
+                0.3 / PICKUP_WHOLE as f32,
+                -2.7e-6,
+                0.25,
+                -0.25,
+                3.0,
+                -3.0,
+            ] {
+                let [i1, i0] = halves(id);
+                let [s1, s0] = halves(step);
+                let [u1, u0] = halves(units as u32);
+                cases.push([[i1, i0, s1, s0], [net, 1.0, u1, u0]]);
+            }
+        }
+    }
+    let helper = "fn exner_probe(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    let id = (u32(a.x) << 16u) | u32(a.y);
+    let units = bitcast<i32>((u32(b.z) << 16u) | u32(b.w));
+    let w = bitcast<u32>(exner_pickup(units, id, (u32(a.z) << 16u) | u32(a.w), b.x, b.y));
+    return vec4<f32>(f32(w >> 16u), f32(w & 0xffffu), 0.0, 0.0);
+}
+";
+    let got = p.run_with(helper, "exner_probe(a, b)", &cases);
+    let mut built = 0;
+    for (i, got) in cases.iter().zip(&got) {
+        let id = ((i[0][0] as u32) << 16) | i[0][1] as u32;
+        let step = ((i[0][2] as u32) << 16) | i[0][3] as u32;
+        let units = (((i[1][2] as u32) << 16) | i[1][3] as u32) as i32;
+        let got = (((got[0] as u32) << 16) | got[1] as u32) as i32;
+        let want = exner_pickup(units, id, step, i[1][0], i[1][1]);
+        let what = format!("id {id}, step {step}, units {units}, net {}", i[1][0]);
+        assert_eq!(got < whole, want.is_some(), "worn away: {what}");
+        if let Some(want) = want {
+            assert_eq!(got, want, "{what}");
+            built += usize::from(want < 0);
+        }
+    }
+    // Not vacuous: some particles end the step built up beyond their own mass.
+    assert!(built > pairs.len(), "{built}");
 }
 
 #[test]

@@ -358,7 +358,7 @@ pub struct Wear {
 pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
     const STEPS: usize = 200;
     use flume_solver::physics::sediment::pass::{Draws, NO_FLUX, rheology_pass_exner};
-    use flume_solver::physics::sediment::pickup::PICKUP_SHIFT;
+    use flume_solver::physics::sediment::pickup::{PICKUP_SHIFT, word_units};
     let (mut sim, _, params) = sediment_in_motion(backend, c, seed, |p| {
         p.vel_rho
             .iter_mut()
@@ -400,7 +400,7 @@ pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
                 // The region and the hold to the bit; the worn units within one, where the
                 // share's fraction, its rate summed in another order (or its step an ulp
                 // apart), falls on the other side of the draw.
-                let (units, want_units) = (got >> PICKUP_SHIFT, want >> PICKUP_SHIFT);
+                let (units, want_units) = (word_units(got), word_units(want));
                 let region_and_hold = (1 << PICKUP_SHIFT) - 1;
                 assert!(
                     got & region_and_hold == want & region_and_hold
@@ -409,7 +409,7 @@ pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
                     k + 1
                 );
                 off_by_one += usize::from(units != want_units);
-                let was = w[i] >> PICKUP_SHIFT;
+                let was = word_units(w[i]);
                 if want_units > 0 && was == 0 {
                     wear.started += 1;
                 }

@@ -20,7 +20,8 @@
 use super::SedimentParams;
 use super::drucker_prager::{alpha, kappa_c, yield_stress};
 use super::pickup::{
-    PICKUP_SHIFT, bed_load_flux, exner_pickup, integrated_pickup, picked_up, pickup_rate,
+    bed_load_flux, exner_exchange, exner_pickup, integrated_pickup, picked_up, pickup_rate,
+    units_word, word_units,
 };
 use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
@@ -90,10 +91,12 @@ pub struct ParticleRheology {
     /// Held fixed this step: un-yielded sediment (region 1).
     pub held: bool,
     /// The share of a held particle's mass the flow has picked up so far, in
-    /// [`PICKUP_WHOLE`](super::pickup::PICKUP_WHOLE)ths (`van_rijn_integrated`; 0 otherwise).
-    pub pickup: u32,
+    /// [`PICKUP_WHOLE`](super::pickup::PICKUP_WHOLE)ths (`van_rijn_integrated` and
+    /// `van_rijn_exner`, negative where more has settled on it than was worn off; 0 otherwise).
+    pub pickup: i32,
     /// The bed load a held particle at the bed's surface passes on downstream, particles per
-    /// second (`van_rijn_exner`, [`super::pickup::bed_load_flux`]); [`NO_FLUX`] for any other.
+    /// second (`van_rijn_exner`, [`super::pickup::exner_exchange`] in a pass with draws, else
+    /// [`super::pickup::bed_load_flux`]); [`NO_FLUX`] for any other.
     /// The pass's, before any release by the stress of its neighbours (`hold.wgsl` leaves it).
     pub flux: f32,
 }
@@ -110,7 +113,7 @@ impl ParticleRheology {
     /// The region word the backends store per particle: the region, `REGION_HELD`, and above
     /// them the mass picked up so far.
     pub fn word(&self) -> u32 {
-        self.region | if self.held { REGION_HELD } else { 0 } | self.pickup << PICKUP_SHIFT
+        self.region | if self.held { REGION_HELD } else { 0 } | units_word(self.pickup)
     }
 }
 
@@ -523,7 +526,7 @@ impl<'a> Rheology<'a> {
         s: &RheologySums,
         ii_d: f32,
         (before, id, upstream): (u32, u32, f32),
-    ) -> (u32, f32, bool, (u32, f32)) {
+    ) -> (u32, f32, bool, (i32, f32)) {
         let held_before = before & REGION_HELD != 0;
         let (model, mat) = (self.model, &self.model.material);
         let sed = &self.params.phases[model.sediment_phase];
@@ -541,7 +544,7 @@ impl<'a> Rheology<'a> {
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
         let stress = (tau_b, tau_bcr);
-        let (picked_up, pickup, flux) = self.pick_up(before >> PICKUP_SHIFT, id, stress, upstream);
+        let (picked_up, pickup, flux) = self.pick_up(word_units(before), id, stress, upstream);
         // The stress the particle carries, which only the Drucker-Prager mode reads.
         let sqrt_j2 = if model.shields_only {
             0.0
@@ -577,11 +580,11 @@ impl Rheology<'_> {
     /// at once, never in a pass without draws.
     fn pick_up(
         &self,
-        units: u32,
+        units: i32,
         id: u32,
         (tau_b, tau_bcr): (f32, f32),
         upstream: f32,
-    ) -> (bool, u32, f32) {
+    ) -> (bool, i32, f32) {
         let per_s = self.model.pickup_per_s;
         if per_s == 0.0 {
             return (true, 0, NO_FLUX);
@@ -596,12 +599,13 @@ impl Rheology<'_> {
         let Some(d) = self.draws else {
             return (false, units, flux);
         };
-        let worn = if step > 0.0 {
-            // E - D with D >= 0: a particle loses at most what is picked up from it, though
-            // its grains' step be longer than dp and nothing come from upstream.
-            exner_pickup(units, id, d.step, (flux - upstream).min(rate), d.dt_s)
+        let (worn, flux) = if step > 0.0 {
+            let (out, net) = exner_exchange(flux, upstream, rate, units, d.dt_s);
+            (exner_pickup(units, id, d.step, net, d.dt_s), out)
         } else if self.model.pickup_integrated {
-            integrated_pickup(units, id, d.step, rate, d.dt_s)
+            let units = units.max(0) as u32;
+            let worn = integrated_pickup(units, id, d.step, rate, d.dt_s);
+            (worn.map(|u| u as i32), flux)
         } else {
             return (picked_up(id, d.step, rate, d.dt_s), 0, NO_FLUX);
         };

@@ -61,11 +61,24 @@ pub fn picked_up(id: u32, step: u32, rate: f32, dt_s: f32) -> bool {
 const LARGEST_CHANCE: f32 = 0.999_999_94;
 
 /// Where a held particle's mass picked up so far sits in its region word: above the region's
-/// byte and `REGION_HELD`, in units of [`PICKUP_WHOLE`]ths of the particle.
+/// byte and `REGION_HELD`, in units of [`PICKUP_WHOLE`]ths of the particle, a two's complement
+/// in the word's top 23 bits. It is negative where more has settled on a particle than was
+/// worn off it (`van_rijn_exner`): the word read as an `i32` and shifted right gives it back.
 pub const PICKUP_SHIFT: u32 = 9;
 
-/// The units of a whole particle's mass: 2^23, all the bits of the word above the hold.
-pub const PICKUP_WHOLE: u32 = 1 << 23;
+/// The units of a whole particle's mass: 2^22, so that a whole particle's surplus fits the
+/// signed 23 bits above the hold as well as its loss.
+pub const PICKUP_WHOLE: u32 = 1 << 22;
+
+/// The units a held particle's word holds, signed (see [`PICKUP_SHIFT`]).
+pub fn word_units(word: u32) -> i32 {
+    (word as i32) >> PICKUP_SHIFT
+}
+
+/// A held particle's `units` in the bits of its word above the hold.
+pub fn units_word(units: i32) -> u32 {
+    (units as u32) << PICKUP_SHIFT
+}
 
 /// The mass a held particle has lost to the flow after a step of `dt_s` at `rate` per second
 /// (`van_rijn_integrated`), from the `units` lost before: None once it reaches the whole
@@ -92,27 +105,41 @@ pub fn saltation_length_per_stage(d50_m: f64, rho_s: f64, rho_w: f64, nu_w: f64,
     3.0 * d50_m * d_star.powf(0.6)
 }
 
-/// The bed load a held surface particle passes on downstream, in particles per second
-/// (`van_rijn_exner`): what it is picked up at, `rate` per second, times the grains' step
-/// `step_per_stage T^0.9` in particle widths (`step_per_stage` the saltation length per
-/// unit `T^0.9` over dp). Grains picked up from a particle's share of the bed land one step
-/// on; where the step is shorter than dp, most land on the particle they left.
+/// The bed load the flow over a held surface particle can carry, in particles per second
+/// (`van_rijn_exner`; [`exner_exchange`] says how much of it the particle passes on): what it
+/// is picked up at, `rate` per second, times the grains' step `step_per_stage T^0.9` in
+/// particle widths (`step_per_stage` the saltation length per unit `T^0.9` over dp). Grains
+/// picked up from a particle's share of the bed land one step on; where the step is shorter
+/// than dp, most land on the particle they left.
 pub fn bed_load_flux(rate: f32, step_per_stage: f32, tau_b: f32, tau_bcr: f32) -> f32 {
     let stage = (tau_b / tau_bcr - 1.0).max(0.0);
     rate * step_per_stage * stage.powf(0.9)
 }
 
+/// Exner's balance for a held surface particle under `van_rijn_exner`: what it passes on and
+/// what it gains or loses per second (`(out, net)`, `net = out - upstream` always, so no sand is
+/// made or lost between particles). It passes on its own bed load `flux`, but no more than
+/// what comes from `upstream` plus what is picked up of it at `rate`: a bed worn only by the
+/// flow cannot supply more. What settles on it (a negative net) fills what was worn off it and
+/// then builds it up, to at most a whole particle more than its own mass (its `units` before,
+/// in `PICKUP_WHOLE`ths, `dt_s` the step); beyond that what comes from upstream passes over it.
+pub fn exner_exchange(flux: f32, upstream: f32, rate: f32, units: i32, dt_s: f32) -> (f32, f32) {
+    let room = (units as f32 + PICKUP_WHOLE as f32) / (PICKUP_WHOLE as f32 * dt_s);
+    let net = (flux.min(upstream + rate) - upstream).max(-room);
+    (upstream + net, net)
+}
+
 /// The mass a held particle has lost to the flow after a step of `dt_s` with `net` per second
-/// worn off it (`van_rijn_exner`: the bed load it passes on less the bed load it is passed,
-/// Exner's balance, negative where more settles on it than leaves), from the `units` lost
-/// before: None once it reaches the whole particle. What settles fills what was worn off, and
-/// no more: a held particle is never more than whole. A step's share is rounded down or up by
-/// particle `id`'s draw at run step `step`, as in [`integrated_pickup`].
-pub fn exner_pickup(units: u32, id: u32, step: u32, net: f32, dt_s: f32) -> Option<u32> {
+/// worn off it ([`exner_exchange`]: negative where more settles on it than leaves), from the
+/// `units` lost before: None once it reaches the whole particle. What settles builds it up to
+/// a whole particle more than its own mass, and no further. A step's share is rounded down or
+/// up by particle `id`'s draw at run step `step`, as in [`integrated_pickup`].
+pub fn exner_pickup(units: i32, id: u32, step: u32, net: f32, dt_s: f32) -> Option<i32> {
+    let whole = PICKUP_WHOLE as i32;
     let share = (net * dt_s).clamp(-1.0, 1.0) * PICKUP_WHOLE as f32;
     let fraction = (pickup_draw(id, step) >> 8) as f32 * (1.0 / 16_777_216.0);
-    let total = i64::from(units) + (share + fraction).floor() as i64;
-    (total < i64::from(PICKUP_WHOLE)).then_some(total.max(0) as u32)
+    let total = units + (share + fraction).floor() as i32;
+    (total < whole).then_some(total.max(-whole))
 }
 
 #[cfg(test)]
@@ -155,10 +182,10 @@ mod tests {
     }
 
     /// A particle worn at a constant rate leaves once the rate's integral reaches its mass:
-    /// at 0.5 per second and steps of 1e-3 s, each step takes 2^22 / 1000 = 4194.304 units,
-    /// 4,194 or 4,195 after the draw's rounding. After 1,999 steps at most 1,999 x 4,195 =
-    /// 8,385,805 are gone, under the whole 2^23 = 8,388,608; after 2,001 at least 2,001 x 4,194
-    /// = 8,392,194.
+    /// at 0.5 per second and steps of 1e-3 s, each step takes 2^21 / 1000 = 2097.152 units,
+    /// 2,097 or 2,098 after the draw's rounding. After 1,999 steps at most 1,999 x 2,098 =
+    /// 4,193,902 are gone, under the whole 2^22 = 4,194,304; after 2,001 at least 2,001 x 2,097
+    /// = 4,196,097.
     #[test]
     fn a_particle_worn_at_a_constant_rate_leaves_when_its_mass_is_gone() {
         let mut units = 0;
@@ -222,20 +249,52 @@ mod tests {
     }
 
     /// Exner's balance worn into a particle: nothing net leaves it as it was for any draw; a
-    /// net 0.5 per second over 1e-3 s takes 4,194 or 4,195 units off what was worn (2^22 /
-    /// 1000 = 4194.3), down to a whole particle and no further; and a net gain that reaches the
-    /// whole releases it, as the pick-up alone does.
+    /// net 0.5 per second over 1e-3 s takes 2,097 or 2,098 units off what was worn (2^21 /
+    /// 1000 = 2097.15), through none to a surplus, down to a whole particle more and no
+    /// further; and a net loss that reaches the whole releases it, as the pick-up alone does.
     #[test]
-    fn what_settles_fills_what_was_worn_and_no_more() {
+    fn what_settles_fills_what_was_worn_then_builds_the_bed() {
         for step in 0..100 {
             assert_eq!(exner_pickup(1234, 7, step, 0.0, 1e-3), Some(1234));
         }
         let filled = exner_pickup(10_000, 7, 1, -0.5, 1e-3).expect("held");
-        assert!((5_805..=5_806).contains(&filled), "{filled}");
-        assert_eq!(exner_pickup(100, 7, 1, -0.5, 1e-3), Some(0));
-        assert_eq!(exner_pickup(0, 7, 1, -50.0, 1.0), Some(0));
-        assert_eq!(exner_pickup(PICKUP_WHOLE - 10, 7, 1, 0.5, 1e-3), None);
+        assert!((7_902..=7_903).contains(&filled), "{filled}");
+        let built = exner_pickup(100, 7, 1, -0.5, 1e-3).expect("held");
+        assert!((-1_998..=-1_997).contains(&built), "{built}");
+        let whole = PICKUP_WHOLE as i32;
+        assert_eq!(exner_pickup(5 - whole, 7, 1, -0.5, 1e-3), Some(-whole));
+        assert_eq!(exner_pickup(whole - 10, 7, 1, 0.5, 1e-3), None);
         let worn = exner_pickup(10_000, 7, 1, 0.5, 1e-3).expect("held");
-        assert!((14_194..=14_195).contains(&worn), "{worn}");
+        assert!((12_097..=12_098).contains(&worn), "{worn}");
+    }
+
+    /// The balance by hand, per second: a particle that could carry 3 with 1 from upstream and
+    /// 0.5 picked up of it passes on 1.5 and loses 0.5; one that carries 0.2 of the same 1
+    /// keeps 0.8; one already built up to a whole particle more keeps none and passes all 1
+    /// on; one with 0.25 of a particle's room left, over a step of 0.1 s, keeps 2.5 per second.
+    #[test]
+    fn a_particle_passes_on_what_it_does_not_keep() {
+        let whole = PICKUP_WHOLE as i32;
+        assert_eq!(exner_exchange(3.0, 1.0, 0.5, 0, 1e-3), (1.5, 0.5));
+        let (out, net) = exner_exchange(0.2, 1.0, 0.5, 0, 1e-3);
+        assert!(
+            (out - 0.2).abs() < 1e-6 && (net + 0.8).abs() < 1e-6,
+            "{out} {net}"
+        );
+        assert_eq!(exner_exchange(0.2, 1.0, 0.5, -whole, 1e-3), (1.0, 0.0));
+        let (out, net) = exner_exchange(0.0, 10.0, 0.5, -3 * whole / 4, 0.1);
+        assert!(
+            (net + 2.5).abs() < 1e-5 && (out - 7.5).abs() < 1e-5,
+            "{out} {net}"
+        );
+    }
+
+    /// A word's units come back signed, a surplus as well as a loss, past the region's bits.
+    #[test]
+    fn units_round_trip_through_the_word() {
+        let whole = PICKUP_WHOLE as i32;
+        for units in [0, 1, -1, whole - 1, -whole, 12_345, -54_321] {
+            assert_eq!(word_units(units_word(units) | 0x1ff), units);
+        }
     }
 }

@@ -3,7 +3,7 @@
 use super::*;
 
 use crate::physics::Phase;
-use crate::physics::sediment::pickup::PICKUP_WHOLE;
+use crate::physics::sediment::pickup::{PICKUP_WHOLE, units_word};
 
 const DEG: f32 = std::f32::consts::PI / 180.0;
 
@@ -218,7 +218,7 @@ fn skeleton_pressure_is_effective_stress_at_the_surface() {
 /// row of water dp over it flowing at 0.5 m/s along +x, worn by van Rijn's pick-up
 /// (`van_rijn_exner` with `exner`, else `van_rijn_integrated`): positions, velocities, and
 /// the region words of a bed held with `worn` of each particle worn off.
-fn worn_bed(exner: bool, worn: u32) -> (SedimentModel, Vec<[f32; 4]>, Vec<[f32; 4]>, Words) {
+fn worn_bed(exner: bool, worn: i32) -> (SedimentModel, Vec<[f32; 4]>, Vec<[f32; 4]>, Words) {
     use crate::physics::sediment::pickup::{pickup_per_s, saltation_length_per_stage};
     let dp = 0.01;
     let mat = crate::physics::sediment::flume_sand();
@@ -241,7 +241,7 @@ fn worn_bed(exner: bool, worn: u32) -> (SedimentModel, Vec<[f32; 4]>, Vec<[f32; 
         for col in -6..=6 {
             pos.push(at(col, -(row as f32) * 0.01, 2));
             vel.push([0.0, 0.0, 0.0, 2710.0]);
-            words.push(Region::Unyielded as u32 | REGION_HELD | worn << PICKUP_SHIFT);
+            words.push(Region::Unyielded as u32 | REGION_HELD | units_word(worn));
         }
     }
     for col in -6..=6 {
@@ -276,22 +276,26 @@ fn wear_for_a_second(
 fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_upstream() {
     let (model, pos, vel, words) = worn_bed(true, 0);
     let none = vec![NO_FLUX; pos.len()];
-    // The first pass passes on each top particle's bed load; nothing is held beneath the top
-    // row's or in the water.
-    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
-    let q = first[top(0)].flux;
+    let whole = PICKUP_WHOLE as f32;
     // By hand: z = dp, 0.5 m/s give u* = 0.037546 m/s and tau_b = 1.4097 Pa (the test above);
     // Re* = 0.037546 x 4e-4 / 1e-6 = 15.018, Eq. 17 theta_cr = 0.010595 ln 15.018 + 0.110476 /
     // 15.018 + 0.0027197 = 0.038781, tau_bcr = 0.038781 x 1710 x 9.81 x 4e-4 = 0.26022 Pa on
-    // the flat bed, T = 4.4174; the rate 5.432e-3 T^1.5 per second (pickup.rs), the step
-    // 3 d50 D*^0.6 T^0.9 / dp = 0.48456 T^0.9 particles (D* = 10.2396): 0.09305 per second.
+    // the flat bed, T = 4.4174; the rate 5.432e-3 T^1.5 = 0.05043 per second (pickup.rs), the
+    // step 3 d50 D*^0.6 T^0.9 / dp = 0.48456 T^0.9 = 1.845 particles (D* = 10.2396), so the
+    // bed load the flow can carry is 0.09305 particles per second.
     let chain_t = 1.4097 / 0.26022 - 1.0_f64;
-    let by_hand = 0.09305;
-    assert!((5.432e-3 * chain_t.powf(1.5) * 0.48456 * chain_t.powf(0.9) - by_hand).abs() < 1e-4);
+    let (rate, capacity) = (0.05043, 0.09305);
+    assert!((5.432e-3 * chain_t.powf(1.5) - rate).abs() < 1e-5);
+    assert!((rate * 0.48456 * chain_t.powf(0.9) - capacity).abs() < 1e-4);
+    // Passed nothing yet, each top particle passes on what is picked up of it, not what the
+    // flow could carry: its pick-up, all of which it loses.
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
+    let e = first[top(0)].flux;
     assert!(
-        (f64::from(q) / by_hand - 1.0).abs() < 0.05,
-        "{q} against {by_hand}"
+        (f64::from(e) / rate - 1.0).abs() < 0.05,
+        "{e} against {rate}"
     );
+    assert!((first[top(0)].pickup as f32 - e * whole).abs() <= 1.0);
     // The bed's end faces are surface too; its middle's buried particles are not.
     for row in 1..5 {
         for col in -3..=3 {
@@ -302,17 +306,26 @@ fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_
     for (k, water) in first.iter().enumerate().skip(65) {
         assert_eq!(water.flux, NO_FLUX, "water particle {k}");
     }
-    // Passed its upstream neighbour's load, a top particle of the bed's middle loses what it
-    // passes on less what it is passed: nothing to a unit in 2^23. The bed's first column,
-    // passed nothing and under a weaker shear at the bed's end, loses what it passes on.
+    // Passed its upstream neighbour's pick-up, a top particle of the bed's middle passes on
+    // what the flow can carry, and loses that less what it was passed.
     let fluxes: Vec<f32> = first.iter().map(|r| r.flux).collect();
     let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    let q = second[top(0)].flux;
+    assert!(
+        (f64::from(q) / capacity - 1.0).abs() < 0.05,
+        "{q} against {capacity}"
+    );
+    assert!((second[top(0)].pickup as f32 - (q - e) * whole).abs() <= 1.0);
+    // Passed that, it loses nothing to a unit in 2^22. The bed's first column, passed nothing
+    // and under a weaker shear at the bed's end, loses what it passes on.
+    let fluxes: Vec<f32> = second.iter().map(|r| r.flux).collect();
+    let third = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
     for col in -1..=2 {
-        let r = &second[top(col)];
-        assert!(r.held && r.pickup <= 2, "column {col}: {r:?}");
+        let r = &third[top(col)];
+        assert!(r.held && r.pickup.abs() <= 2, "column {col}: {r:?}");
     }
-    let first_col = &second[top(-6)];
-    let own = first_col.flux * PICKUP_WHOLE as f32;
+    let first_col = &third[top(-6)];
+    let own = first_col.flux * whole;
     assert!(
         (first_col.pickup as f32 - own).abs() <= 1.0,
         "{first_col:?}"
@@ -320,57 +333,58 @@ fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_
     // Worn by the pick-up alone, the middle loses as much as the first particle.
     let (gross, pos, vel, words) = worn_bed(false, 0);
     let alone = wear_for_a_second(&gross, (&pos, &vel), (&words, &none));
-    let rate = f64::from(alone[top(0)].pickup) / f64::from(PICKUP_WHOLE);
-    assert!(
-        (rate / (5.432e-3 * chain_t.powf(1.5)) - 1.0).abs() < 0.05,
-        "{rate}"
-    );
-    // Passed nothing (column -1 made to pass none on), column 0 loses what is picked up from
-    // it and no more: its grains' step, 0.48456 x 4.4174^0.9 = 1.84 dp, is longer than the
-    // particle, so what it passes on is 1.84 times its pick-up, and E - D with D >= 0 cannot
-    // exceed E.
+    let picked = f64::from(alone[top(0)].pickup) / f64::from(PICKUP_WHOLE);
+    assert!((picked / rate - 1.0).abs() < 0.05, "{picked}");
+    // Starved again (column -1 made to pass none on), column 0 loses its pick-up and no more,
+    // though its grains' step is longer than the particle, and passes on only that.
     let mut starved = fluxes.clone();
     starved[top(-1)] = 0.0;
     let (model, pos, vel, words) = worn_bed(true, 0);
-    let third = wear_for_a_second(&model, (&pos, &vel), (&words, &starved));
-    assert_eq!(
-        third[top(0)].pickup,
-        alone[top(0)].pickup,
-        "{:?}",
-        third[top(0)]
-    );
-    assert!(
-        third[top(0)].flux > 1.8 * rate as f32,
-        "{:?}",
-        third[top(0)]
-    );
+    let fourth = wear_for_a_second(&model, (&pos, &vel), (&words, &starved));
+    let r = &fourth[top(0)];
+    assert_eq!(r.pickup, alone[top(0)].pickup, "{r:?}");
+    assert!((f64::from(r.flux) / picked - 1.0).abs() < 1e-4, "{r:?}");
+}
+
+/// Each particle gains what it is passed less what it passes on: `units` after the pass
+/// against those before, within the draw's rounding.
+fn assert_balanced(r: &ParticleRheology, before: i32, passed: f32) {
+    let want = before as f32 + (r.flux - passed) * PICKUP_WHOLE as f32;
+    assert!((r.pickup as f32 - want).abs() <= 2.0, "{r:?}: {want}");
 }
 
 #[test]
-fn bed_load_from_upstream_fills_what_was_worn_and_no_more() {
-    let half = PICKUP_WHOLE / 2;
+fn bed_load_from_upstream_fills_what_was_worn_then_builds_the_bed() {
+    let whole = PICKUP_WHOLE as i32;
+    let half = whole / 2;
     let (model, pos, vel, words) = worn_bed(true, half);
     let none = vec![NO_FLUX; pos.len()];
     let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
     let mut fluxes: Vec<f32> = first.iter().map(|r| r.flux).collect();
-    // Column -1 passed on twice its load: column 0, downstream of it, is filled by its own.
-    let q = fluxes[top(0)];
-    fluxes[top(-1)] = 2.0 * q;
+    // Column -1 passes on ten times its pick-up, more than the flow carries: column 0 keeps
+    // what it cannot pass on.
+    let e = fluxes[top(0)];
+    fluxes[top(-1)] = 10.0 * e;
     // The particle under column 2, given five times the load, lies dp farther from the point
     // upstream of column 3 than column 2 itself: column 3 is passed column 2's.
-    fluxes[top(2) + 13] = 5.0 * q;
+    fluxes[top(2) + 13] = 5.0 * e;
     let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
-    let filled = second[top(0)].pickup as f32;
-    let want = half as f32 - q * PICKUP_WHOLE as f32;
-    assert!((filled - want).abs() <= 1.0, "{filled} against {want}");
     assert!(
-        second[top(3)].pickup.abs_diff(half) <= 2,
+        second[top(0)].pickup < half - whole / 4,
         "{:?}",
-        second[top(3)]
+        second[top(0)]
     );
-    // Passed more than was worn off it, a particle is whole again, not more.
+    assert_balanced(&second[top(0)], half, 10.0 * e);
+    assert_balanced(&second[top(3)], half, e);
+    // Passed more than was worn off it, a particle builds the bed up: more than whole, held.
     let (model, pos, vel, words) = worn_bed(true, 100);
     let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
-    assert_eq!(second[top(0)].pickup, 0, "{:?}", second[top(0)]);
-    assert!(second[top(0)].held);
+    assert!(second[top(0)].held && second[top(0)].pickup < -whole / 4);
+    assert_balanced(&second[top(0)], 100, 10.0 * e);
+    // Built up a whole particle more, all but a thousand units, it keeps those and passes the
+    // rest on.
+    let (model, pos, vel, words) = worn_bed(true, 1000 - whole);
+    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    assert!(second[top(0)].pickup <= 1 - whole, "{:?}", second[top(0)]);
+    assert_balanced(&second[top(0)], 1000 - whole, 10.0 * e);
 }
