@@ -27,6 +27,8 @@ const PICKUP_SHIFT: u32 = 9u;
 const PICKUP_WHOLE: u32 = 4194304u;
 // The bed load of a particle that is not held at the bed's surface (`NO_FLUX` of pass.rs).
 const NO_FLUX: f32 = -1.0;
+// The particle a held particle passes its bed load to when none is (`NO_TARGET` of pass.rs).
+const NO_TARGET: u32 = 4294967295u;
 
 // Eq. 17 (van Rijn 1993); "infinite" (HUGE) at Re* <= 0.
 fn critical_shields(re_star: f32) -> f32 {

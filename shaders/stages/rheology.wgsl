@@ -96,6 +96,7 @@ struct Chosen {
     mu: f32,
     pickup: i32,   // the mass picked up of a held particle so far, signed (pickup.rs)
     flux: f32,     // the bed load it passes on (pass.rs's ParticleRheology::flux)
+    to_id: u32,   // the particle it passes it to (ParticleRheology::target)
 }
 
 // Where in `regions` the fluxes of the pass at run step `step` lie: after the words, the even
@@ -104,34 +105,52 @@ fn flux_slot(step: u32) -> u32 {
     return params.n_particles * (1u + (step & 1u));
 }
 
-// The bed load that the held particle upstream of the sediment particle at pos_i passed on in
-// the last step's pass, read from `slot` (`Upstream` of pass.rs): of the held particles at the
-// surface, the one nearest the point dp up the flow of the nearest water, within dp of it.
-fn upstream_flux(pos_i: vec3<f32>, g: Gathered, slot: u32) -> f32 {
+// Where in `regions` the particles the fluxes of the pass at run step `step` went to lie: after
+// the fluxes, the even steps' then the odd steps'.
+fn target_slot(step: u32) -> u32 {
+    return params.n_particles * (3u + (step & 1u));
+}
+
+// The bed-load exchange of the held surface particle `id_i` at pos_i with its neighbours
+// (`Exchange` of pass.rs), from the last step's pass's fluxes at `slot` and the particles they
+// went to at `to_slot`: the loads of those that named it, and the particle held at the surface
+// nearest the point dp down the flow of the nearest water, within dp of it, that it names.
+struct Exchanged {
+    passed: f32,
+    to_id: u32,
+}
+
+fn bed_load_exchange(
+    pos_i: vec3<f32>, id_i: u32, g: Gathered, slot: u32, to_slot: u32
+) -> Exchanged {
     let dp = params.sediment.dp;
     let along = g.nearest_u / length(g.nearest_u);
-    let at = pos_i - dp * along;
+    let at = pos_i + dp * along;
     var best_d2 = dp * dp;
-    var best = 0.0;
+    var ex = Exchanged(0.0, NO_TARGET);
     let cell = cell_coords(pos_i);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
         let range = stencil_row(cell, row);
         for (var j = range.x; j < range.y; j++) {
-            let pos_j = textureLoad(positions, texel(j), 0).xyz;
-            let flux_j = bitcast<f32>(regions[slot + ids[j]]);
-            if (flux_j < 0.0 || all(pos_j == pos_i)) {
+            let id_j = ids[j];
+            let flux_j = bitcast<f32>(regions[slot + id_j]);
+            if (flux_j < 0.0 || id_j == id_i) {
                 continue;
             }
-            let d = pos_j - at;
+            if (regions[to_slot + id_j] == id_i) {
+                ex.passed += flux_j;
+            }
+            let d = textureLoad(positions, texel(j), 0).xyz - at;
             let d2 = d.x * d.x + d.y * d.y + d.z * d.z;
-            // The lesser flux of two at the same distance: the same choice in any order.
-            if (d2 < best_d2 || (d2 == best_d2 && flux_j < best)) {
+            // The lesser id of two at the same distance: the same choice in any order.
+            let tie = d2 == best_d2 && ex.to_id != NO_TARGET && id_j < ex.to_id;
+            if (d2 < best_d2 || tie) {
                 best_d2 = d2;
-                best = flux_j;
+                ex.to_id = id_j;
             }
         }
     }
-    return best;
+    return ex;
 }
 
 // Sediment particle i at pos_i: its region and apparent viscosity from its sums, its density
@@ -166,12 +185,16 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     // Worn net of what settles from upstream: Exner's balance (`van_rijn_exner`).
     let exner = sd.exner_step_per_stage > 0.0;
     var flux = bed_load_flux(rate, tau_b, tau_bcr);
+    var to_id = NO_TARGET;
     if (!picked && BEFORE_DT) {
         let step = state.run_steps + state.steps;
         if (exner) {
             var upstream = 0.0;
             if (held_before && at_surface && length(g.nearest_u) > 0.0) {
-                upstream = upstream_flux(pos_i, g, flux_slot(step + 1u));
+                let last = step + 1u;
+                let ex = bed_load_exchange(pos_i, ids[i], g, flux_slot(last), target_slot(last));
+                upstream = ex.passed;
+                to_id = ex.to_id;
             }
             let exchange = exner_exchange(flux, upstream, rate, pickup, state.dt_taken);
             flux = exchange.x;
@@ -195,7 +218,8 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     let kept = select(0, pickup, region == REGION_UNYIELDED && held_before);
     let passed = exner && !picked && region == REGION_UNYIELDED && at_surface;
     let mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
-    return Chosen(region, mu, kept, select(NO_FLUX, flux, passed));
+    let to = select(NO_TARGET, to_id, passed);
+    return Chosen(region, mu, kept, select(NO_FLUX, flux, passed), to);
 }
 
 @compute @workgroup_size(64)
@@ -244,12 +268,14 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     var region = REGION_WATER;
     var pickup = 0;
     var flux = NO_FLUX;
+    var to_id = NO_TARGET;
     if (is_sediment) {
         let chosen = sediment_rheology(i, pos_i.xyz, rho_i, g, ii_d);
         region = chosen.region;
         mu = chosen.mu;
         pickup = chosen.pickup;
         flux = chosen.flux;
+        to_id = chosen.to_id;
     }
     // Shields-only holds carry no stress; Drucker-Prager holds keep theirs (hold.rs).
     let held = region == REGION_UNYIELDED;
@@ -264,6 +290,8 @@ fn rheology(@builtin(global_invocation_id) gid: vec3<u32>) {
     regions[ids[i]] = word | (bitcast<u32>(pickup) << PICKUP_SHIFT);
     // The pass that wears the bed passes its bed load on to the next one's.
     if (BEFORE_DT && sd.exner_step_per_stage > 0.0) {
-        regions[flux_slot(state.run_steps + state.steps) + ids[i]] = bitcast<u32>(flux);
+        let step = state.run_steps + state.steps;
+        regions[flux_slot(step) + ids[i]] = bitcast<u32>(flux);
+        regions[target_slot(step) + ids[i]] = to_id;
     }
 }

@@ -24,7 +24,7 @@ use crate::engine::{PipelineShape, by_id};
 use crate::error::SolverError;
 use crate::particles::Particles;
 use crate::physics;
-use crate::physics::sediment::pass::{NO_FLUX, SedimentModel};
+use crate::physics::sediment::pass::{NO_FLUX, NO_TARGET, SedimentModel};
 use crate::physics::sediment::suspension::Region;
 use grid::Grid;
 use std::sync::Arc;
@@ -89,9 +89,9 @@ pub struct CpuEngine {
     /// Region words by id (region | REGION_HELD), as the last rheology pass left them.
     regions: Vec<u32>,
     /// The bed load each held particle at the surface passed on in the last pass that drew
-    /// (`van_rijn_exner`), by id; `NO_FLUX` for any other.
-    fluxes: Vec<f32>,
-    snapshot: (State, Vec<u32>, Vec<f32>),
+    /// (`van_rijn_exner`), and the id it passed it to, by id; `NO_FLUX` for any other.
+    fluxes: Vec<(f32, u32)>,
+    snapshot: (State, Vec<u32>, Vec<(f32, u32)>),
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
     seconds: [f64; STAGES.len()],
@@ -131,7 +131,7 @@ impl CpuEngine {
             vel_rho_prev: particles.vel_rho.clone(),
         };
         let regions = vec![0; particles.len()];
-        let fluxes = vec![NO_FLUX; particles.len()];
+        let fluxes = vec![(NO_FLUX, NO_TARGET); particles.len()];
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
             pool: Arc::new(pool),

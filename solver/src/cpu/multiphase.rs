@@ -21,7 +21,7 @@ use crate::physics::interaction::phase_index;
 use crate::physics::lanes::{LANES, Lanes};
 use crate::physics::sediment::hold::{Release, Transmitted};
 use crate::physics::sediment::pass::{
-    Draws, NO_FLUX, ParticleRheology, REGION_HELD, Rheology, RheologySide, RheologySums,
+    Draws, NO_FLUX, NO_TARGET, ParticleRheology, REGION_HELD, Rheology, RheologySide, RheologySums,
     SedimentModel,
 };
 use crate::physics::sediment::suspension::Region;
@@ -34,9 +34,9 @@ pub struct Holds<'a> {
     pub words: &'a [u32],
     /// The particles' ids (sorted order): their draws'.
     pub ids: &'a [u32],
-    /// The bed load each held particle at the surface passed on in the last pass, by id
-    /// (`van_rijn_exner`; [`NO_FLUX`] for any other).
-    pub fluxes: &'a [f32],
+    /// The bed load each held particle at the surface passed on in the last pass, and the id
+    /// it passed it to, by id (`van_rijn_exner`; [`NO_FLUX`] for any other).
+    pub fluxes: &'a [(f32, u32)],
     pub draws: Option<Draws>,
     /// Whether held grains far from anything moving sleep (see the module doc); false: every
     /// grain runs its sums (the full computation the awake set is checked against).
@@ -105,6 +105,7 @@ pub fn rheology_pass(
         held: false,
         pickup: 0,
         flux: NO_FLUX,
+        target: NO_TARGET,
     };
     let mut out = vec![none; n];
     let asleep = pool.install(|| {
@@ -169,6 +170,9 @@ fn stirring(params: &Params, (pos, vel): (&[[f32; 4]], &[[f32; 4]]), words: &[u3
     Flagged::new(words.len(), |k| !rests(k))
 }
 
+/// What a particle that exchanges no bed load is passed, and where its own goes.
+const NONE_PASSED: (f32, u32) = (0.0, NO_TARGET);
+
 /// Particles per block handed to a thread, as in the force pass.
 const BLOCK: usize = 64;
 
@@ -182,8 +186,8 @@ struct Pairs<'a> {
     vol: &'a [f32],
     sides: &'a [RheologySide],
     ids: &'a [u32],
-    /// The last pass's bed load by id (`Holds::fluxes`).
-    fluxes: &'a [f32],
+    /// The last pass's bed load and where it went, by id (`Holds::fluxes`).
+    fluxes: &'a [(f32, u32)],
     /// The region words of the last pass.
     words: &'a [u32],
     /// The grains that may sleep in this pass.
@@ -212,15 +216,15 @@ impl Pairs<'_> {
                 for i in group.range.clone() {
                     let s = pass.start(&pos[i], &vel[i]);
                     let before = (self.words[i], self.ids[i]);
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, 0.0);
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
                 }
             } else {
                 let sums = self.group(&group);
                 for (lane, i) in group.range.clone().enumerate() {
                     let s = sums.lane(lane);
-                    let upstream = self.upstream(i, &s);
+                    let exchange = self.exchange(i, &s);
                     let before = (self.words[i], self.ids[i]);
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, upstream);
+                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, exchange);
                 }
             }
             start = group.range.end;
@@ -228,21 +232,22 @@ impl Pairs<'_> {
         asleep
     }
 
-    /// The bed load the held particle upstream of particle `i` passed on in the last pass, from
-    /// its sums `s` (0: none, or no deposition): the cells within reach hold it, since it
-    /// lies within 2 dp of `i`.
-    fn upstream(&self, i: usize, s: &RheologySums) -> f32 {
-        let Some(mut up) = self.pass.upstream_of(&self.pos[i], s, self.words[i]) else {
-            return 0.0;
-        };
+    /// The bed load passed to particle `i` in the last pass and the particle it passes its own
+    /// to, from its sums `s` (none without deposition): the cells within reach hold both, since
+    /// each lies within 2 dp of `i`.
+    fn exchange(&self, i: usize, s: &RheologySums) -> (f32, u32) {
         let x = &self.pos[i];
+        let Some(mut ex) = self.pass.exchange_of((x, self.ids[i]), s, self.words[i]) else {
+            return NONE_PASSED;
+        };
         self.grid
             .rows(self.grid.coords(&[x[0], x[1], x[2]]), |range| {
                 for j in range {
-                    up.add(&self.pos[j], self.fluxes[self.ids[j] as usize]);
+                    let id_j = self.ids[j];
+                    ex.add(&self.pos[j], id_j, self.fluxes[id_j as usize]);
                 }
             });
-        up.flux()
+        ex.outcome()
     }
 
     /// The sums of `group`, from each particle's own start.
@@ -296,7 +301,7 @@ mod tests {
             .map(|i| if i % 3 == 0 { REGION_HELD } else { 0 })
             .collect();
         let ids: Vec<u32> = (0..n as u32).collect();
-        let fluxes = vec![NO_FLUX; n];
+        let fluxes = vec![(NO_FLUX, NO_TARGET); n];
         let (params, grid) = (&fx.params, &fx.grid);
         let pass_with = |awake_set| {
             let holds = Holds {
@@ -325,7 +330,7 @@ mod tests {
                         }
                     });
                 }
-                pass.finish(x, v, &s, (held[i], ids[i]), 0.0)
+                pass.finish(x, v, &s, (held[i], ids[i]), NONE_PASSED)
             })
             .collect();
         let word_bits = |r: &[ParticleRheology]| -> Vec<(u32, u32, Vec<u32>)> {

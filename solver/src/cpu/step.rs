@@ -14,7 +14,7 @@ use crate::health::Health;
 use crate::physics::integrate::{Particle, bed_wall, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
 use crate::physics::sediment::pass::REGION_HELD;
-use crate::physics::sediment::pass::{Draws, NO_FLUX, ParticleRheology};
+use crate::physics::sediment::pass::{Draws, NO_FLUX, NO_TARGET, ParticleRheology};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
@@ -169,10 +169,10 @@ impl CpuEngine {
             .is_some_and(|m| m.exner_step_per_stage > 0.0);
         if draws.is_some() && exner {
             for (r, &id) in pass.out.iter().zip(&b.ids) {
-                self.fluxes[id as usize] = r.flux;
+                self.fluxes[id as usize] = (r.flux, r.target);
             }
             for &id in &b.ids[active..] {
-                self.fluxes[id as usize] = NO_FLUX;
+                self.fluxes[id as usize] = (NO_FLUX, NO_TARGET);
             }
         }
         Some(pass.out)

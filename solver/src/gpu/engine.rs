@@ -10,7 +10,7 @@ use crate::engine::{Engine, InletScan, PipelineShape, RawState, StageTime, by_id
 use crate::error::SolverError;
 use crate::gpu::pipeline::{Bindings, SphPipeline};
 use crate::particles::Particles;
-use crate::physics::sediment::pass::NO_FLUX;
+use crate::physics::sediment::pass::{NO_FLUX, NO_TARGET};
 use std::sync::Arc;
 
 pub struct GpuEngine {
@@ -49,11 +49,17 @@ impl GpuEngine {
         );
         gpu.queue
             .write_buffer(&buffers.probe_points, 0, bytemuck::cast_slice(probe_points));
-        // No particle has passed any bed load on before the first pass.
+        // No particle has passed any bed load on, to any other, before the first pass.
         let no_flux = vec![NO_FLUX; 2 * particles.len()];
         let fluxes_at = particles.len() as u64 * 4;
         gpu.queue
             .write_buffer(&buffers.regions, fluxes_at, bytemuck::cast_slice(&no_flux));
+        let no_target = vec![NO_TARGET; 2 * particles.len()];
+        gpu.queue.write_buffer(
+            &buffers.regions,
+            3 * fluxes_at,
+            bytemuck::cast_slice(&no_target),
+        );
         let pipeline = SphPipeline::new(
             &gpu,
             shape.dim,

@@ -28,7 +28,8 @@ pub struct GpuBuffers {
     pub stress_b: wgpu::TextureView,
     /// [`REGION_SLOTS`] runs of one word per particle id: the region words, then the bed load
     /// each held particle at the surface passed on (f32 bits, `van_rijn_exner`) in the steps
-    /// of even and of odd run count, one read while the other is written.
+    /// of even and of odd run count, one read while the other is written, then the ids of the
+    /// particles it passed them to, likewise.
     pub regions: wgpu::Buffer,
     /// A copy of `regions` taken with `snapshot`: which sediment is held is state too.
     pub regions_snapshot: wgpu::Buffer,
@@ -72,8 +73,9 @@ impl StateTextures {
 /// Bytes of one `vec4<f32>` particle attribute (positions, velocity-density, forces).
 pub const VEC4_BYTES: u64 = 16;
 
-/// The runs of one word per particle in `GpuBuffers::regions`: words and two steps' fluxes.
-pub const REGION_SLOTS: u64 = 3;
+/// The runs of one word per particle in `GpuBuffers::regions`: words, two steps' fluxes and the
+/// two steps' particles they went to.
+pub const REGION_SLOTS: u64 = 5;
 
 impl GpuBuffers {
     /// Checks every large buffer against the adapter's limits before anything is allocated.

@@ -357,7 +357,7 @@ pub struct Wear {
 /// shares be rounded both down and up.
 pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
     const STEPS: usize = 200;
-    use flume_solver::physics::sediment::pass::{Draws, NO_FLUX, rheology_pass_exner};
+    use flume_solver::physics::sediment::pass::{Draws, NO_FLUX, NO_TARGET, rheology_pass_exner};
     use flume_solver::physics::sediment::pickup::{PICKUP_SHIFT, word_units};
     let (mut sim, _, params) = sediment_in_motion(backend, c, seed, |p| {
         p.vel_rho
@@ -371,7 +371,8 @@ pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
         .collect();
     let mut t = 0.0f64;
     let mut before = (sim.read_particles().expect("readback"), Vec::new());
-    let mut fluxes = vec![NO_FLUX; before.0.len()];
+    let n = before.0.len();
+    let mut fluxes = (vec![NO_FLUX; n], vec![NO_TARGET; n]);
     let mut wear = Wear {
         started: 0,
         carried: 0,
@@ -389,11 +390,13 @@ pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
         };
         let w = if k > 0 { w.clone() } else { words.clone() };
         let state = (p.positions.as_slice(), p.vel_rho.as_slice());
-        let oracle = rheology_pass_exner(&params, &model, state, (&w, &fluxes), Some(draws));
+        let passed = (w.as_slice(), fluxes.0.as_slice(), fluxes.1.as_slice());
+        let oracle = rheology_pass_exner(&params, &model, state, passed, Some(draws));
         // The same pass with nothing passed on from upstream.
-        let unsupplied = vec![NO_FLUX; fluxes.len()];
-        let alone = rheology_pass_exner(&params, &model, state, (&w, &unsupplied), Some(draws));
-        fluxes = oracle.iter().map(|r| r.flux).collect();
+        let unsupplied = vec![NO_TARGET; n];
+        let passed = (w.as_slice(), fluxes.0.as_slice(), unsupplied.as_slice());
+        let alone = rheology_pass_exner(&params, &model, state, passed, Some(draws));
+        fluxes = oracle.iter().map(|r| (r.flux, r.target)).unzip();
         if k > 0 {
             for (i, r) in oracle.iter().enumerate() {
                 let (got, want) = (words[i], r.word());

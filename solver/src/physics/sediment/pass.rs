@@ -99,6 +99,8 @@ pub struct ParticleRheology {
     /// [`super::pickup::bed_load_flux`]); [`NO_FLUX`] for any other.
     /// The pass's, before any release by the stress of its neighbours (`hold.wgsl` leaves it).
     pub flux: f32,
+    /// The id of the particle it passes that load to ([`NO_TARGET`]: none, or off the bed).
+    pub target: u32,
 }
 
 /// The flux of a particle that is not held at the bed's surface, or of a pass without
@@ -438,15 +440,15 @@ impl<'a> Rheology<'a> {
 
     /// Particle i's rheology from its sums, `before` its region word after the previous pass
     /// (whether it was held, and what of it was picked up; see [`rheology_pass`]), `id` its
-    /// id (its pick-up draw's), `upstream` the bed load the held particle upstream of it passes
-    /// on ([`Upstream`]; 0 with none).
+    /// id (its pick-up draw's), `exchange` the bed load it was passed in the last pass and the
+    /// particle it passes its own to ([`Exchange`]; `(0.0, NO_TARGET)` with none).
     pub fn finish(
         &self,
         x_i: &[f32; 4],
         v_i: &[f32; 4],
         s: &RheologySums,
         (before, id): (u32, u32),
-        upstream: f32,
+        (upstream, target): (f32, u32),
     ) -> ParticleRheology {
         let params = self.params;
         let phase_i = &params.phases[phase_index(x_i)];
@@ -458,6 +460,7 @@ impl<'a> Rheology<'a> {
                 held: false,
                 pickup: 0,
                 flux: NO_FLUX,
+                target: NO_TARGET,
             };
         }
         let eps = strain_rate(&s.grad, params.dim);
@@ -485,6 +488,7 @@ impl<'a> Rheology<'a> {
             held,
             pickup,
             flux,
+            target: if flux == NO_FLUX { NO_TARGET } else { target },
         }
     }
 
@@ -615,18 +619,23 @@ impl Rheology<'_> {
         }
     }
 
-    /// Where the held particle upstream of sediment particle `x_i` lies, when what is worn off
-    /// it is net of what settles on it (`van_rijn_exner`): dp up the flow of the water nearest
-    /// it, from its sums `s`, if it was held (`before` its word) and lies at the bed's surface,
-    /// in a pass that wears the bed (one with draws; another would not read it).
-    pub fn upstream_of(&self, x_i: &[f32; 4], s: &RheologySums, before: u32) -> Option<Upstream> {
+    /// The bed-load exchange of sediment particle `id` at `x_i` with its neighbours, when what
+    /// is worn off it is net of what settles on it (`van_rijn_exner`), down the flow of the
+    /// water nearest it, from its sums `s`: if it was held (`before` its word) and lies at the
+    /// bed's surface, in a pass that wears the bed (one with draws; another would not read it).
+    pub fn exchange_of(
+        &self,
+        (x_i, id): (&[f32; 4], u32),
+        s: &RheologySums,
+        before: u32,
+    ) -> Option<Exchange> {
         let speed = norm3(s.water_u);
         let wears = self.model.exner_step_per_stage > 0.0
             && self.draws.is_some()
             && before & REGION_HELD != 0;
         (wears && self.at_surface(s) && speed > 0.0 && self.is_sediment(x_i)).then(|| {
             let along = std::array::from_fn(|k| s.water_u[k] / speed);
-            Upstream::new([x_i[0], x_i[1], x_i[2]], along, self.model.dp_m)
+            Exchange::new(id, [x_i[0], x_i[1], x_i[2]], along, self.model.dp_m)
         })
     }
 
@@ -637,11 +646,11 @@ impl Rheology<'_> {
     }
 }
 
+mod exchange;
 mod oracle;
-mod upstream;
 
+pub use exchange::{Exchange, NO_TARGET};
 pub use oracle::{rheology_pass, rheology_pass_drawn, rheology_pass_exner};
-pub use upstream::Upstream;
 
 #[cfg(test)]
 mod tests;

@@ -1,7 +1,7 @@
 //! The rheology pass particle by particle over every other, the oracle the backends' cell-list
 //! passes are held to.
 
-use super::{Draws, NO_FLUX, ParticleRheology, REGION_HELD, Rheology, SedimentModel};
+use super::{Draws, NO_FLUX, NO_TARGET, ParticleRheology, REGION_HELD, Rheology, SedimentModel};
 use crate::physics::Params;
 
 /// The rheology of every particle (see the module doc), `held_before[i]` whether particle i was
@@ -37,25 +37,26 @@ pub fn rheology_pass_drawn(
     words_before: &[u32],
     draws: Option<Draws>,
 ) -> Vec<ParticleRheology> {
-    let none = vec![NO_FLUX; pos.len()];
-    rheology_pass_exner(params, model, (pos, vel_rho), (words_before, &none), draws)
+    let none = (vec![NO_FLUX; pos.len()], vec![NO_TARGET; pos.len()]);
+    let before = (words_before, none.0.as_slice(), none.1.as_slice());
+    rheology_pass_exner(params, model, (pos, vel_rho), before, draws)
 }
 
 /// [`rheology_pass_drawn`] with the bed load each held particle at the surface passed on in
-/// the last pass, `fluxes_before` ([`ParticleRheology::flux`]), which `van_rijn_exner` settles
-/// on the particle downstream.
+/// the last pass, `fluxes_before` ([`ParticleRheology::flux`]), and the particle it passed it
+/// to, `targets_before` ([`ParticleRheology::target`]), on which `van_rijn_exner` settles it.
 pub fn rheology_pass_exner(
     params: &Params,
     model: &SedimentModel,
     (pos, vel_rho): (&[[f32; 4]], &[[f32; 4]]),
-    (words_before, fluxes_before): (&[u32], &[f32]),
+    (words_before, fluxes_before, targets_before): (&[u32], &[f32], &[u32]),
     draws: Option<Draws>,
 ) -> Vec<ParticleRheology> {
     assert_eq!(pos.len(), vel_rho.len(), "positions and velocities differ");
     assert_eq!(pos.len(), words_before.len(), "positions and words differ");
     assert_eq!(
-        pos.len(),
-        fluxes_before.len(),
+        (pos.len(), pos.len()),
+        (fluxes_before.len(), targets_before.len()),
         "positions and fluxes differ"
     );
     let pass = Rheology::new(params, model).with_draws(draws);
@@ -65,16 +66,16 @@ pub fn rheology_pass_exner(
             for j in 0..pos.len() {
                 pass.add_pair((&pos[i], &vel_rho[i]), (&pos[j], &vel_rho[j]), &mut s);
             }
-            let upstream = pass
-                .upstream_of(&pos[i], &s, words_before[i])
-                .map(|mut up| {
-                    for (x_j, &flux_j) in pos.iter().zip(fluxes_before) {
-                        up.add(x_j, flux_j);
+            let exchange = pass
+                .exchange_of((&pos[i], i as u32), &s, words_before[i])
+                .map_or((0.0, NO_TARGET), |mut ex| {
+                    for (j, x_j) in pos.iter().enumerate() {
+                        ex.add(x_j, j as u32, (fluxes_before[j], targets_before[j]));
                     }
-                    up.flux()
+                    ex.outcome()
                 });
             let before = (words_before[i], i as u32);
-            pass.finish(&pos[i], &vel_rho[i], &s, before, upstream.unwrap_or(0.0))
+            pass.finish(&pos[i], &vel_rho[i], &s, before, exchange)
         })
         .collect()
 }

@@ -261,21 +261,30 @@ fn top(col: i32) -> usize {
 }
 
 /// One pass of a second over [`worn_bed`] (the step's share then its whole second's), from
-/// the words and fluxes before: what each particle gives.
+/// the words, and the loads passed on and where, before: what each particle gives.
 fn wear_for_a_second(
     model: &SedimentModel,
     (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
-    (words, fluxes): (&[u32], &[f32]),
+    (words, passed): (&[u32], &Passed),
 ) -> Vec<ParticleRheology> {
     let params = flume_case().0;
     let draws = Some(Draws { step: 1, dt_s: 1.0 });
-    rheology_pass_exner(&params, model, (pos, vel), (words, fluxes), draws)
+    let before = (words, passed.0.as_slice(), passed.1.as_slice());
+    rheology_pass_exner(&params, model, (pos, vel), before, draws)
+}
+
+/// The loads particles passed on in a pass, and the particles they passed them to.
+type Passed = (Vec<f32>, Vec<u32>);
+
+/// What the particles of a pass passed on, and to which.
+fn passed(out: &[ParticleRheology]) -> Passed {
+    out.iter().map(|r| (r.flux, r.target)).unzip()
 }
 
 #[test]
 fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_upstream() {
     let (model, pos, vel, words) = worn_bed(true, 0);
-    let none = vec![NO_FLUX; pos.len()];
+    let none = (vec![NO_FLUX; pos.len()], vec![NO_TARGET; pos.len()]);
     let whole = PICKUP_WHOLE as f32;
     // By hand: z = dp, 0.5 m/s give u* = 0.037546 m/s and tau_b = 1.4097 Pa (the test above);
     // Re* = 0.037546 x 4e-4 / 1e-6 = 15.018, Eq. 17 theta_cr = 0.010595 ln 15.018 + 0.110476 /
@@ -288,7 +297,8 @@ fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_
     assert!((5.432e-3 * chain_t.powf(1.5) - rate).abs() < 1e-5);
     assert!((rate * 0.48456 * chain_t.powf(0.9) - capacity).abs() < 1e-4);
     // Passed nothing yet, each top particle passes on what is picked up of it, not what the
-    // flow could carry: its pick-up, all of which it loses.
+    // flow could carry: its pick-up, all of which it loses. None knew which of its neighbours
+    // were held at the surface, so none names one downstream; from the next pass they do.
     let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
     let e = first[top(0)].flux;
     assert!(
@@ -296,20 +306,34 @@ fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_
         "{e} against {rate}"
     );
     assert!((first[top(0)].pickup as f32 - e * whole).abs() <= 1.0);
+    assert!(first.iter().all(|r| r.target == NO_TARGET));
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &passed(&first)));
+    assert!((first[top(0)].pickup as f32 - e * whole).abs() <= 1.0);
     // The bed's end faces are surface too; its middle's buried particles are not.
     for row in 1..5 {
         for col in -3..=3 {
             let k = top(col) + 13 * row;
-            assert_eq!(first[k].flux, NO_FLUX, "buried particle {k}");
+            assert_eq!(
+                (first[k].flux, first[k].target),
+                (NO_FLUX, NO_TARGET),
+                "buried {k}"
+            );
         }
     }
     for (k, water) in first.iter().enumerate().skip(65) {
         assert_eq!(water.flux, NO_FLUX, "water particle {k}");
     }
+    // Each top particle passes its load to the next downstream (ids are indices here). The
+    // bed's last column, under the shear at its end, is picked up whole, so the one before it
+    // names none: its load leaves the bed.
+    for col in -6..5 {
+        assert_eq!(first[top(col)].target, top(col + 1) as u32, "column {col}");
+    }
+    assert!(!first[top(6)].held);
+    assert_eq!(first[top(5)].target, NO_TARGET);
     // Passed its upstream neighbour's pick-up, a top particle of the bed's middle passes on
     // what the flow can carry, and loses that less what it was passed.
-    let fluxes: Vec<f32> = first.iter().map(|r| r.flux).collect();
-    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &passed(&first)));
     let q = second[top(0)].flux;
     assert!(
         (f64::from(q) / capacity - 1.0).abs() < 0.05,
@@ -318,7 +342,7 @@ fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_
     assert!((second[top(0)].pickup as f32 - (q - e) * whole).abs() <= 1.0);
     // Passed that, it loses nothing to a unit in 2^22. The bed's first column, passed nothing
     // and under a weaker shear at the bed's end, loses what it passes on.
-    let fluxes: Vec<f32> = second.iter().map(|r| r.flux).collect();
+    let fluxes = passed(&second);
     let third = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
     for col in -1..=2 {
         let r = &third[top(col)];
@@ -338,7 +362,7 @@ fn a_bed_under_a_flow_the_same_all_along_it_wears_only_where_nothing_comes_from_
     // Starved again (column -1 made to pass none on), column 0 loses its pick-up and no more,
     // though its grains' step is longer than the particle, and passes on only that.
     let mut starved = fluxes.clone();
-    starved[top(-1)] = 0.0;
+    starved.0[top(-1)] = 0.0;
     let (model, pos, vel, words) = worn_bed(true, 0);
     let fourth = wear_for_a_second(&model, (&pos, &vel), (&words, &starved));
     let r = &fourth[top(0)];
@@ -358,16 +382,17 @@ fn bed_load_from_upstream_fills_what_was_worn_then_builds_the_bed() {
     let whole = PICKUP_WHOLE as i32;
     let half = whole / 2;
     let (model, pos, vel, words) = worn_bed(true, half);
-    let none = vec![NO_FLUX; pos.len()];
+    let none = (vec![NO_FLUX; pos.len()], vec![NO_TARGET; pos.len()]);
     let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
-    let mut fluxes: Vec<f32> = first.iter().map(|r| r.flux).collect();
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &passed(&first)));
+    let mut fluxes = passed(&first);
     // Column -1 passes on ten times its pick-up, more than the flow carries: column 0 keeps
     // what it cannot pass on.
-    let e = fluxes[top(0)];
-    fluxes[top(-1)] = 10.0 * e;
-    // The particle under column 2, given five times the load, lies dp farther from the point
-    // upstream of column 3 than column 2 itself: column 3 is passed column 2's.
-    fluxes[top(2) + 13] = 5.0 * e;
+    let e = fluxes.0[top(0)];
+    fluxes.0[top(-1)] = 10.0 * e;
+    // Column 1 passes its load to column 3, past column 2: column 2 is passed nothing and
+    // column 3 both loads, each counted once.
+    fluxes.1[top(1)] = top(3) as u32;
     let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
     assert!(
         second[top(0)].pickup < half - whole / 4,
@@ -375,7 +400,8 @@ fn bed_load_from_upstream_fills_what_was_worn_then_builds_the_bed() {
         second[top(0)]
     );
     assert_balanced(&second[top(0)], half, 10.0 * e);
-    assert_balanced(&second[top(3)], half, e);
+    assert_balanced(&second[top(2)], half, 0.0);
+    assert_balanced(&second[top(3)], half, 2.0 * e);
     // Passed more than was worn off it, a particle builds the bed up: more than whole, held.
     let (model, pos, vel, words) = worn_bed(true, 100);
     let second = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));

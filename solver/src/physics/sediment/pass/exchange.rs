@@ -1,0 +1,59 @@
+//! Where the bed load a held particle passes on goes, and what settles on it (`van_rijn_exner`).
+
+/// No particle: what a particle with none downstream of it passes on leaves the bed (over its
+/// end into the pit, or down a step).
+pub const NO_TARGET: u32 = u32::MAX;
+
+/// The bed-load exchange of a held particle at the bed's surface with its neighbours
+/// ([`Rheology::exchange_of`](super::Rheology::exchange_of)). It passes its load on to the
+/// particle held at the surface in the last pass nearest the point dp down the flow, within dp
+/// of it (grains picked up from it land one step on), and names that one; it is passed the
+/// loads of every particle that named it in the last pass. Each load thus goes to one particle,
+/// or off the bed, and no sand is counted twice where the bed is uneven. A particle newly at
+/// the surface is named from the pass after.
+#[derive(Clone, Copy, Debug)]
+pub struct Exchange {
+    at: [f32; 3],
+    id: u32,
+    d2: f32,
+    target: u32,
+    passed: f32,
+}
+
+impl Exchange {
+    /// The exchange of particle `id` at `from`, flowed over along the unit vector `along`, on
+    /// a bed of particles `dp` apart.
+    pub(super) fn new(id: u32, from: [f32; 3], along: [f32; 3], dp: f32) -> Exchange {
+        Exchange {
+            at: std::array::from_fn(|k| from[k] + dp * along[k]),
+            id,
+            d2: dp * dp,
+            target: NO_TARGET,
+            passed: 0.0,
+        }
+    }
+
+    /// Weighs neighbour `id_j` at `x_j`, which in the last pass passed on `flux_j` to
+    /// `target_j` ([`NO_FLUX`](super::NO_FLUX): not a held particle at the surface).
+    pub fn add(&mut self, x_j: &[f32; 4], id_j: u32, (flux_j, target_j): (f32, u32)) {
+        if flux_j < 0.0 || id_j == self.id {
+            return;
+        }
+        if target_j == self.id {
+            self.passed += flux_j;
+        }
+        let d2: f32 = (0..3).map(|k| (x_j[k] - self.at[k]).powi(2)).sum();
+        // The lesser id of two at the same distance: the same choice in any order.
+        let tie = d2 == self.d2 && self.target != NO_TARGET && id_j < self.target;
+        if d2 < self.d2 || tie {
+            self.d2 = d2;
+            self.target = id_j;
+        }
+    }
+
+    /// The bed load passed to the particle in the last pass, particles per second, and the
+    /// particle it passes its own to ([`NO_TARGET`]: none).
+    pub fn outcome(&self) -> (f32, u32) {
+        (self.passed, self.target)
+    }
+}
