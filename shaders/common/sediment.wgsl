@@ -20,11 +20,12 @@ const REGION_SUSPENDED: u32 = 4u;
 const REGION_WATER: u32 = 5u;
 // Set in a particle's region word when it is held fixed this step.
 const REGION_HELD: u32 = 256u;
-// Above the hold: the mass picked up of a held particle so far, in PICKUP_WHOLE-ths of it, a
-// two's complement read by shifting the word as an i32 (`PICKUP_SHIFT`, `PICKUP_WHOLE` of
-// pickup.rs).
+// Above the hold: the mass picked up of a held particle so far, in PICKUP_WHOLE-ths of it; under
+// Exner's balance in EXNER_WHOLE-ths, a two's complement read by shifting the word as an i32
+// (`PICKUP_SHIFT`, `PICKUP_WHOLE`, `EXNER_WHOLE` of pickup.rs).
 const PICKUP_SHIFT: u32 = 9u;
-const PICKUP_WHOLE: u32 = 4194304u;
+const PICKUP_WHOLE: u32 = 8388608u;
+const EXNER_WHOLE: u32 = 4194304u;
 // The bed load of a particle that is not held at the bed's surface (`NO_FLUX` of pass.rs).
 const NO_FLUX: f32 = -1.0;
 // The particle a held particle passes its bed load to when none is (`NO_TARGET` of pass.rs).
@@ -289,19 +290,19 @@ fn bed_load_flux(rate: f32, tau_b: f32, tau_bcr: f32) -> f32 {
 // load from `upstream` plus its pick-up at `rate`, and what settles on it no more than builds
 // it up to a whole particle more than its own mass (`exner_exchange` in pickup.rs).
 fn exner_exchange(flux: f32, upstream: f32, rate: f32, units: i32, dt: f32) -> vec2<f32> {
-    let room = (f32(units) + f32(PICKUP_WHOLE)) / (f32(PICKUP_WHOLE) * dt);
+    let room = (f32(units) + f32(EXNER_WHOLE)) / (f32(EXNER_WHOLE) * dt);
     let net = max(min(flux, upstream + rate) - upstream, -room);
     return vec2<f32>(upstream + net, net);
 }
 
 // The mass worn off a held particle after a step of `dt` with `net` per second worn (negative:
-// settled), from `units` before: PICKUP_WHOLE or more once none is left, never below a whole
+// settled), from `units` before: EXNER_WHOLE or more once none is left, never below a whole
 // particle's surplus (`exner_pickup` in pickup.rs; the step's share rounded down or up by the
 // particle's draw).
 fn exner_pickup(units: i32, id: u32, step: u32, net: f32, dt: f32) -> i32 {
-    let share = clamp(net * dt, -1.0, 1.0) * f32(PICKUP_WHOLE);
+    let share = clamp(net * dt, -1.0, 1.0) * f32(EXNER_WHOLE);
     let fraction = f32(pickup_draw(id, step) >> 8u) * (1.0 / 16777216.0);
-    return max(units + i32(floor(share + fraction)), -i32(PICKUP_WHOLE));
+    return max(units + i32(floor(share + fraction)), -i32(EXNER_WHOLE));
 }
 
 // A sediment particle's region (Figure 2 with the hold; `sediment_region` in pass.rs): in the

@@ -180,10 +180,12 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     }
     // The pass before the step's size is chosen draws the pick-ups, one draw a step.
     var picked = sd.pickup_per_s == 0.0;
-    var pickup = select(bitcast<i32>(before) >> PICKUP_SHIFT, 0, picked);
-    let rate = pickup_rate(tau_b, tau_bcr);
-    // Worn net of what settles from upstream: Exner's balance (`van_rijn_exner`).
+    // Worn net of what settles from upstream: Exner's balance (`van_rijn_exner`), whose units
+    // are signed (`word_units` in pickup.rs).
     let exner = sd.exner_step_per_stage > 0.0;
+    let units = select(i32(before >> PICKUP_SHIFT), bitcast<i32>(before) >> PICKUP_SHIFT, exner);
+    var pickup = select(units, 0, picked);
+    let rate = pickup_rate(tau_b, tau_bcr);
     var flux = bed_load_flux(rate, tau_b, tau_bcr);
     var to_id = NO_TARGET;
     if (!picked && BEFORE_DT) {
@@ -199,7 +201,7 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
             let exchange = exner_exchange(flux, upstream, rate, pickup, state.dt_taken);
             flux = exchange.x;
             let worn = exner_pickup(pickup, ids[i], step, exchange.y, state.dt_taken);
-            picked = worn >= i32(PICKUP_WHOLE);
+            picked = worn >= i32(EXNER_WHOLE);
             pickup = select(worn, 0, picked);
         } else if (sd.pickup_integrated != 0u) {
             let worn = integrated_pickup(u32(max(pickup, 0)), ids[i], step, rate, state.dt_taken);

@@ -15,9 +15,8 @@
 //! - **moving**: regions 2 and 3;
 //! - **deposited**: held or un-yielded again on the bed.
 
-use crate::config::Case;
+use crate::config::{Case, Erosion};
 use crate::particles::{ParticleRegion, Particles};
-use crate::physics::sediment::pickup::PICKUP_WHOLE;
 use crate::physics::sediment::suspension::Region;
 
 /// Equal stretches of the bed, by where its grains started, that the budget counts apart.
@@ -74,6 +73,8 @@ pub struct SedimentBudget {
     dp: f64,
     /// The collector's upstream edge, m: sand beyond it has left the bed.
     past_bed_x_m: f64,
+    /// Whether the sand wears net of what settles (`van_rijn_exner`): its words' units signed.
+    exner: bool,
     edges_m: [f64; STRETCHES + 1],
 }
 
@@ -83,6 +84,10 @@ impl SedimentBudget {
     pub fn new(case: &Case, initial: &Particles) -> Option<SedimentBudget> {
         let flume = case.open_flume.as_ref()?;
         let (sand, _) = case.sediment_phases()?;
+        let exner = case.phases[sand]
+            .sediment
+            .as_ref()
+            .is_some_and(|s| s.erosion == Erosion::VanRijnExner);
         let sand_phase = sand as u32 + 1;
         let grains: Vec<Grain> = (0..initial.len())
             .filter(|&i| initial.phase(i) == sand_phase)
@@ -111,6 +116,7 @@ impl SedimentBudget {
             sand_phase,
             dp,
             past_bed_x_m: flume.collector.x_min_m,
+            exner,
             edges_m,
         })
     }
@@ -154,7 +160,7 @@ impl SedimentBudget {
             worn: 0.0,
             worn_by_stretch: [0.0; STRETCHES],
         };
-        let mut worn_units = [0i64; STRETCHES];
+        let mut worn = [0.0; STRETCHES];
         let (sand_phase, dp, past_bed_x) = (self.sand_phase, self.dp, self.past_bed_x_m);
         let edges = self.edges_m;
         for g in &mut self.grains {
@@ -164,7 +170,7 @@ impl SedimentBudget {
                 let (x, y) = (f64::from(p[0]), f64::from(p[1]));
                 g.last_x = x;
                 let decoded = ParticleRegion::from_word(regions.get(g.id).copied().unwrap_or(0));
-                worn_units[stretch(&edges, g.start[0])] += i64::from(decoded.worn_units);
+                worn[stretch(&edges, g.start[0])] += decoded.worn(self.exner);
                 let region = decoded.region;
                 let shifted = (x - g.start[0]).hypot(y - g.start[1]) > 0.5 * dp;
                 let yielded = matches!(
@@ -203,9 +209,8 @@ impl SedimentBudget {
             row.furthest_m = row.furthest_m.max(travel);
             row.mobilised_by_stretch[stretch(&edges, g.start[0])] += 1;
         }
-        let whole = f64::from(PICKUP_WHOLE);
-        row.worn_by_stretch = worn_units.map(|u| u as f64 / whole);
-        row.worn = worn_units.iter().sum::<i64>() as f64 / whole;
+        row.worn_by_stretch = worn;
+        row.worn = worn.iter().sum();
         row
     }
 }

@@ -4,7 +4,7 @@
 
 use crate::config::Case;
 use crate::physics::sediment::pass::REGION_HELD;
-use crate::physics::sediment::pickup::word_units;
+use crate::physics::sediment::pickup::{EXNER_WHOLE, PICKUP_SHIFT, PICKUP_WHOLE, word_units};
 use crate::physics::sediment::suspension::Region;
 
 /// Phase index 0 on the GPU is the wall; case phase k is GPU phase k + 1.
@@ -95,10 +95,9 @@ pub struct ParticleRegion {
     pub region: Option<Region>,
     /// Sediment held fixed in the last rheology pass.
     pub held: bool,
-    /// The share of a held particle's mass a pick-up worn away has taken off it, in
-    /// `PICKUP_WHOLE`ths, negative where more has settled on it than was worn off it; 0 for a
-    /// particle not held.
-    pub worn_units: i32,
+    /// The bits above the hold of a held particle's word, the share of its mass a pick-up worn
+    /// away has taken off it ([`ParticleRegion::worn`]); 0 for a particle not held.
+    pub worn_bits: u32,
 }
 
 impl ParticleRegion {
@@ -115,8 +114,17 @@ impl ParticleRegion {
         ParticleRegion {
             region,
             held,
-            worn_units: if held { word_units(word) } else { 0 },
+            worn_bits: if held { word >> PICKUP_SHIFT } else { 0 },
         }
+    }
+
+    /// The share of a held particle's mass worn off it, in particles: under Exner's balance
+    /// (`exner`, `van_rijn_exner`) net of what settled on it, negative where that is more;
+    /// else by the pick-up alone (`van_rijn_integrated`).
+    pub fn worn(&self, exner: bool) -> f64 {
+        let units = word_units(self.worn_bits << PICKUP_SHIFT, exner);
+        let whole = if exner { EXNER_WHOLE } else { PICKUP_WHOLE };
+        f64::from(units) / f64::from(whole)
     }
 
     /// The paper's number of the region, 1-5, and 0 for none: what particle frames, snapshots
@@ -136,21 +144,27 @@ mod tests {
 
     #[test]
     fn a_region_word_is_the_region_the_held_bit_and_the_wear() {
-        let worn = units_word(3);
-        let built =
-            ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD | units_word(-5));
-        assert_eq!(built.worn_units, -5, "a surplus settled on a held particle");
-        let held_unyielded =
-            ParticleRegion::from_word(Region::Unyielded as u32 | REGION_HELD | worn);
+        let held = Region::Unyielded as u32 | REGION_HELD;
+        // A quarter worn off by the pick-up alone, an eighth settled past a whole under Exner.
+        let worn = units_word(PICKUP_WHOLE as i32 / 4);
+        let built = ParticleRegion::from_word(held | units_word(-(EXNER_WHOLE as i32) / 8));
+        assert_eq!(
+            built.worn(true),
+            -0.125,
+            "a surplus settled on a held particle"
+        );
+        let held_unyielded = ParticleRegion::from_word(held | worn);
         assert_eq!(held_unyielded.region, Some(Region::Unyielded));
         assert!(held_unyielded.held);
-        assert_eq!(held_unyielded.worn_units, 3);
+        assert_eq!(held_unyielded.worn(false), 0.25);
         assert_eq!(held_unyielded.number(), 1);
+        // Under Exner's balance the same bits are half a particle's loss.
+        assert_eq!(held_unyielded.worn(true), 0.5);
         // Units in the word of a particle not held are no wear.
         let water = ParticleRegion::from_word(Region::Water as u32 | worn);
         assert_eq!(
-            (water.number(), water.held, water.worn_units),
-            (5, false, 0)
+            (water.number(), water.held, water.worn(false)),
+            (5, false, 0.0)
         );
         assert_eq!(ParticleRegion::from_word(0), ParticleRegion::default());
     }

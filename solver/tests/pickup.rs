@@ -19,7 +19,6 @@ mod common;
 
 use common::case_path;
 use flume_solver::budget::SedimentBudget;
-use flume_solver::physics::sediment::pickup::{PICKUP_WHOLE, word_units};
 use flume_solver::{Backend, Case, ParticleRegion, Simulation};
 use std::sync::OnceLock;
 
@@ -27,8 +26,8 @@ const END_S: f64 = 4.0;
 
 /// The twin's CI flume with pick-up `erosion`: the grains set moving by [`END_S`] and, for
 /// each held grain, where it lies along the flume (m) and the share of its mass it has lost,
-/// in [`PICKUP_WHOLE`]ths (negative where more settled on it than was worn off).
-fn front_over_the_bed(erosion: &str) -> (u64, Vec<(f32, i32)>) {
+/// in particles (negative where more settled on it than was worn off).
+fn front_over_the_bed(erosion: &str) -> (u64, Vec<(f32, f64)>) {
     let set = [
         "numerics.dp_m=0.01".to_string(),
         "open_flume.reservoir_particles=2500".to_string(),
@@ -52,30 +51,30 @@ fn front_over_the_bed(erosion: &str) -> (u64, Vec<(f32, i32)>) {
     }
     let regions = sim.regions().expect("regions");
     let now = sim.read_particles().expect("reads");
+    let exner = erosion == "van_rijn_exner";
     let worn = regions
         .iter()
+        .map(|&w| ParticleRegion::from_word(w))
         .zip(&now.positions)
-        .filter(|(w, _)| ParticleRegion::from_word(**w).held)
-        .map(|(w, x)| (x[0], word_units(*w)))
+        .filter(|(r, _)| r.held)
+        .map(|(r, x)| (x[0], r.worn(exner)))
         .collect();
     (mobilised, worn)
 }
 
 /// [`front_over_the_bed`] worn away (`van_rijn_integrated`), run once for both tests.
-fn worn_away() -> &'static (u64, Vec<(f32, i32)>) {
-    static RUN: OnceLock<(u64, Vec<(f32, i32)>)> = OnceLock::new();
+fn worn_away() -> &'static (u64, Vec<(f32, f64)>) {
+    static RUN: OnceLock<(u64, Vec<(f32, f64)>)> = OnceLock::new();
     RUN.get_or_init(|| front_over_the_bed("van_rijn_integrated"))
 }
 
 /// The grains' mass worn off the held grains of `worn` between `from_m` and `to_m` along the
 /// flume, net of what settled on them, and how many held grains there have lost or gained.
-fn worn_between(worn: &[(f32, i32)], from_m: f32, to_m: f32) -> (f64, usize) {
+fn worn_between(worn: &[(f32, f64)], from_m: f32, to_m: f32) -> (f64, usize) {
     let there = worn
         .iter()
-        .filter(|(x, u)| *u != 0 && (from_m..to_m).contains(x));
-    there.fold((0.0, 0), |(mass, n), (_, u)| {
-        (mass + f64::from(*u) / f64::from(PICKUP_WHOLE), n + 1)
-    })
+        .filter(|(x, u)| *u != 0.0 && (from_m..to_m).contains(x));
+    there.fold((0.0, 0), |(mass, n), (_, u)| (mass + u, n + 1))
 }
 
 #[test]
@@ -84,8 +83,8 @@ fn the_front_wears_the_bed_where_a_chance_lifted_whole_grains() {
     let (worn_away, worn) = (worn_away().0, &worn_away().1);
     let touched: Vec<f64> = worn
         .iter()
-        .filter(|(_, u)| *u > 0)
-        .map(|(_, u)| f64::from(*u) / f64::from(PICKUP_WHOLE))
+        .filter(|(_, u)| *u > 0.0)
+        .map(|&(_, u)| u)
         .collect();
     let most = touched.iter().copied().fold(0.0, f64::max);
     let total: f64 = touched.iter().sum();
@@ -99,7 +98,7 @@ fn the_front_wears_the_bed_where_a_chance_lifted_whole_grains() {
     assert!(worn_away <= 2, "{worn_away} grains worn away by 4 s");
     // The chance keeps no account of what it wore; worn away, the front wore most of the
     // wetted surface, a fraction of a grain each.
-    assert!(worn_by_chance.iter().all(|(_, u)| *u == 0));
+    assert!(worn_by_chance.iter().all(|(_, u)| *u == 0.0));
     assert!(touched.len() >= 100, "{} grains worn", touched.len());
     assert!(most < 1.0, "{most}");
     // The same rate either way: the mass worn off is what the chance lifts whole, within the

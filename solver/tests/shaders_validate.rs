@@ -212,6 +212,7 @@ fn every_constant_stated_on_both_sides_agrees() {
         ("rheology", "REGION_HELD", U32(pass::REGION_HELD)),
         ("rheology", "PICKUP_SHIFT", U32(pickup::PICKUP_SHIFT)),
         ("rheology", "PICKUP_WHOLE", U32(pickup::PICKUP_WHOLE)),
+        ("rheology", "EXNER_WHOLE", U32(pickup::EXNER_WHOLE)),
         ("rheology", "NO_FLUX", F32(pass::NO_FLUX)),
         ("rheology", "NO_TARGET", U32(pass::NO_TARGET)),
         (

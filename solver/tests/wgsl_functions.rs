@@ -27,8 +27,8 @@ use flume_solver::physics::kernel::Wendland;
 use flume_solver::physics::sediment::drucker_prager::{alpha, kappa_c, yield_stress};
 use flume_solver::physics::sediment::pass::{skeleton_pressure, slope_factors};
 use flume_solver::physics::sediment::pickup::{
-    PICKUP_WHOLE, exner_exchange, exner_pickup, integrated_pickup, picked_up, pickup_draw,
-    pickup_rate,
+    EXNER_WHOLE, PICKUP_WHOLE, exner_exchange, exner_pickup, integrated_pickup, picked_up,
+    pickup_draw, pickup_rate,
 };
 use flume_solver::physics::sediment::rheology::hbp_viscosity;
 use flume_solver::physics::sediment::shields::{critical_shields, friction_velocity};
@@ -407,7 +407,7 @@ fn the_pickup() {
 fn worn_away_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]) {
     let mut cases = Vec::new();
     for &(id, step) in pairs {
-        for units in [0u32, 1, PICKUP_WHOLE / 2, PICKUP_WHOLE - 1] {
+        for units in [0u32, 1, 4_194_304, PICKUP_WHOLE - 1] {
             for share in [0.0f32, 0.3 / PICKUP_WHOLE as f32, 2.7e-6, 0.25, 1.0, 3.0] {
                 let [i1, i0] = halves(id);
                 let [s1, s0] = halves(step);
@@ -461,7 +461,7 @@ fn worn_away_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32
 /// its units to the unit from a whole particle's surplus to one unit short of its loss, for
 /// losses and gains from none through a fraction of a unit to a whole particle.
 fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]) {
-    let whole = PICKUP_WHOLE as i32;
+    let whole = EXNER_WHOLE as i32;
     let mut exchanges = Vec::new();
     for units in [-whole, 1000 - whole, -1, 0, whole / 2] {
         for (flux, upstream, rate) in [(0.09, 0.0, 0.05), (0.09, 0.05, 0.05), (0.02, 0.5, 0.05)] {
@@ -486,7 +486,7 @@ fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]
         for units in [-whole, 5 - whole, -1, 0, 1, whole / 2, whole - 1] {
             for net in [
                 0.0f32,
-                0.3 / PICKUP_WHOLE as f32,
+                0.3 / EXNER_WHOLE as f32,
                 -2.7e-6,
                 0.25,
                 -0.25,

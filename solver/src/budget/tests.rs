@@ -100,13 +100,12 @@ fn each_grain_is_booked_where_it_is_and_stays_mobilised() {
 }
 
 /// The mass worn off grains still held, whether or not they have moved, and by the stretch
-/// the grain started in: a quarter of one untouched grain and three eighths of another, less an
-/// eighth settled on a third beyond its own mass; the units left in the word of a grain that is
-/// not held, and of water, are no grain's wear.
+/// the grain started in: a quarter of one untouched grain and three eighths of another, and
+/// under Exner's balance less an eighth settled on a third beyond its own mass; the units left
+/// in the word of a grain that is not held, and of water, are no grain's wear.
 #[test]
 fn worn_is_the_wear_of_the_held_grains() {
-    use crate::physics::sediment::pickup::{PICKUP_WHOLE, units_word};
-    let case = collector_case();
+    use crate::physics::sediment::pickup::{EXNER_WHOLE, PICKUP_WHOLE, units_word};
     let at = [
         ([0.010, 0.010], SAND),
         ([0.050, 0.010], SAND),
@@ -114,19 +113,29 @@ fn worn_is_the_wear_of_the_held_grains() {
         ([0.120, 0.010], SAND),
         ([0.1, 0.05], WATER),
     ];
-    let mut budget = SedimentBudget::new(&case, &particles(&at)).expect("sand in a flume");
-    let units = |whole_over: i32, times: i32| units_word(PICKUP_WHOLE as i32 / whole_over * times);
-    let regions = [
-        HELD | units(4, 1),
-        HELD | units(8, 3),
-        Region::BedLoad as u32 | units(2, 1),
-        HELD | units(8, -1),
-        Region::Water as u32 | REGION_HELD | units(2, 1),
-    ];
-    let row = budget.update(1.0, &particles(&at), &regions, 0);
-    assert_eq!(row.mobilised, 1, "only the bed-load grain moved");
-    assert!((row.worn - 0.5).abs() < 1e-12, "{}", row.worn);
+    let worn = |case: &Case, whole: u32, last: i32| {
+        let mut budget = SedimentBudget::new(case, &particles(&at)).expect("sand in a flume");
+        let units = |over: i32, times: i32| units_word(whole as i32 / over * times);
+        let regions = [
+            HELD | units(4, 1),
+            HELD | units(8, 3),
+            Region::BedLoad as u32 | units(2, 1),
+            HELD | units(8, last),
+            Region::Water as u32 | REGION_HELD | units(2, 1),
+        ];
+        let row = budget.update(1.0, &particles(&at), &regions, 0);
+        assert_eq!(row.mobilised, 1, "only the bed-load grain moved");
+        row
+    };
     // The four grains span 0.0075-0.1225 m: the first two lie in the first two stretches, the
     // last in the last.
-    assert_eq!(row.worn_by_stretch, [0.25, 0.375, 0.0, 0.0, -0.125]);
+    let alone = worn(&collector_case(), PICKUP_WHOLE, 0);
+    assert!((alone.worn - 0.625).abs() < 1e-12, "{}", alone.worn);
+    assert_eq!(alone.worn_by_stretch, [0.25, 0.375, 0.0, 0.0, 0.0]);
+    let set = ["phases.1.sediment.erosion=van_rijn_exner".to_string()];
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cases/collector_2d.yaml");
+    let exner = Case::from_path_with(std::path::Path::new(path), &set).expect("the case");
+    let net = worn(&exner, EXNER_WHOLE, -1);
+    assert!((net.worn - 0.5).abs() < 1e-12, "{}", net.worn);
+    assert_eq!(net.worn_by_stretch, [0.25, 0.375, 0.0, 0.0, -0.125]);
 }

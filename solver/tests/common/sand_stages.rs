@@ -403,7 +403,8 @@ pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
                 // The region and the hold to the bit; the worn units within one, where the
                 // share's fraction, its rate summed in another order (or its step an ulp
                 // apart), falls on the other side of the draw.
-                let (units, want_units) = (word_units(got), word_units(want));
+                let exner = model.exner_step_per_stage > 0.0;
+                let (units, want_units) = (word_units(got, exner), word_units(want, exner));
                 let region_and_hold = (1 << PICKUP_SHIFT) - 1;
                 assert!(
                     got & region_and_hold == want & region_and_hold
@@ -412,7 +413,7 @@ pub fn check_wear(backend: &Backend, c: &Case, seed: u64, calm: f32) -> Wear {
                     k + 1
                 );
                 off_by_one += usize::from(units != want_units);
-                let was = word_units(w[i]);
+                let was = word_units(w[i], exner);
                 if want_units > 0 && was == 0 {
                     wear.started += 1;
                 }

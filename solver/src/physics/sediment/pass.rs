@@ -91,8 +91,9 @@ pub struct ParticleRheology {
     /// Held fixed this step: un-yielded sediment (region 1).
     pub held: bool,
     /// The share of a held particle's mass the flow has picked up so far, in
-    /// [`PICKUP_WHOLE`](super::pickup::PICKUP_WHOLE)ths (`van_rijn_integrated` and
-    /// `van_rijn_exner`, negative where more has settled on it than was worn off; 0 otherwise).
+    /// [`PICKUP_WHOLE`](super::pickup::PICKUP_WHOLE)ths (`van_rijn_integrated`), or in
+    /// [`EXNER_WHOLE`](super::pickup::EXNER_WHOLE)ths net of what settled on it, negative where
+    /// that is more than was worn off (`van_rijn_exner`); 0 otherwise.
     pub pickup: i32,
     /// The bed load a held particle at the bed's surface passes on downstream, particles per
     /// second (`van_rijn_exner`, [`super::pickup::exner_exchange`] in a pass with draws, else
@@ -548,7 +549,12 @@ impl<'a> Rheology<'a> {
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
         let stress = (tau_b, tau_bcr);
-        let (picked_up, pickup, flux) = self.pick_up(word_units(before), id, stress, upstream);
+        let (picked_up, pickup, flux) = self.pick_up(
+            word_units(before, model.exner_step_per_stage > 0.0),
+            id,
+            stress,
+            upstream,
+        );
         // The stress the particle carries, which only the Drucker-Prager mode reads.
         let sqrt_j2 = if model.shields_only {
             0.0

@@ -61,18 +61,28 @@ pub fn picked_up(id: u32, step: u32, rate: f32, dt_s: f32) -> bool {
 const LARGEST_CHANCE: f32 = 0.999_999_94;
 
 /// Where a held particle's mass picked up so far sits in its region word: above the region's
-/// byte and `REGION_HELD`, in units of [`PICKUP_WHOLE`]ths of the particle, a two's complement
-/// in the word's top 23 bits. It is negative where more has settled on a particle than was
-/// worn off it (`van_rijn_exner`): the word read as an `i32` and shifted right gives it back.
+/// byte and `REGION_HELD`, in the word's top 23 bits. Under `van_rijn_integrated` they count
+/// [`PICKUP_WHOLE`]ths of the particle lost; under `van_rijn_exner` they are a two's complement
+/// of [`EXNER_WHOLE`]ths, negative where more has settled on a particle than was worn off it
+/// ([`word_units`]).
 pub const PICKUP_SHIFT: u32 = 9;
 
-/// The units of a whole particle's mass: 2^22, so that a whole particle's surplus fits the
-/// signed 23 bits above the hold as well as its loss.
-pub const PICKUP_WHOLE: u32 = 1 << 22;
+/// The units of a whole particle's mass worn by the pick-up alone: 2^23, all the bits of the
+/// word above the hold.
+pub const PICKUP_WHOLE: u32 = 1 << 23;
 
-/// The units a held particle's word holds, signed (see [`PICKUP_SHIFT`]).
-pub fn word_units(word: u32) -> i32 {
-    (word as i32) >> PICKUP_SHIFT
+/// The units of a whole particle's mass worn net of what settles (`van_rijn_exner`): 2^22, so
+/// that a whole particle's surplus fits the signed 23 bits above the hold as well as its loss.
+pub const EXNER_WHOLE: u32 = 1 << 22;
+
+/// The units a held particle's word holds: signed, in [`EXNER_WHOLE`]ths, under `exner`; else
+/// in [`PICKUP_WHOLE`]ths.
+pub fn word_units(word: u32, exner: bool) -> i32 {
+    if exner {
+        (word as i32) >> PICKUP_SHIFT
+    } else {
+        (word >> PICKUP_SHIFT) as i32
+    }
 }
 
 /// A held particle's `units` in the bits of its word above the hold.
@@ -122,9 +132,9 @@ pub fn bed_load_flux(rate: f32, step_per_stage: f32, tau_b: f32, tau_bcr: f32) -
 /// what comes from `upstream` plus what is picked up of it at `rate`: a bed worn only by the
 /// flow cannot supply more. What settles on it (a negative net) fills what was worn off it and
 /// then builds it up, to at most a whole particle more than its own mass (its `units` before,
-/// in `PICKUP_WHOLE`ths, `dt_s` the step); beyond that what comes from upstream passes over it.
+/// in `EXNER_WHOLE`ths, `dt_s` the step); beyond that what comes from upstream passes over it.
 pub fn exner_exchange(flux: f32, upstream: f32, rate: f32, units: i32, dt_s: f32) -> (f32, f32) {
-    let room = (units as f32 + PICKUP_WHOLE as f32) / (PICKUP_WHOLE as f32 * dt_s);
+    let room = (units as f32 + EXNER_WHOLE as f32) / (EXNER_WHOLE as f32 * dt_s);
     let net = (flux.min(upstream + rate) - upstream).max(-room);
     (upstream + net, net)
 }
@@ -135,8 +145,8 @@ pub fn exner_exchange(flux: f32, upstream: f32, rate: f32, units: i32, dt_s: f32
 /// a whole particle more than its own mass, and no further. A step's share is rounded down or
 /// up by particle `id`'s draw at run step `step`, as in [`integrated_pickup`].
 pub fn exner_pickup(units: i32, id: u32, step: u32, net: f32, dt_s: f32) -> Option<i32> {
-    let whole = PICKUP_WHOLE as i32;
-    let share = (net * dt_s).clamp(-1.0, 1.0) * PICKUP_WHOLE as f32;
+    let whole = EXNER_WHOLE as i32;
+    let share = (net * dt_s).clamp(-1.0, 1.0) * EXNER_WHOLE as f32;
     let fraction = (pickup_draw(id, step) >> 8) as f32 * (1.0 / 16_777_216.0);
     let total = units + (share + fraction).floor() as i32;
     (total < whole).then_some(total.max(-whole))
@@ -182,10 +192,10 @@ mod tests {
     }
 
     /// A particle worn at a constant rate leaves once the rate's integral reaches its mass:
-    /// at 0.5 per second and steps of 1e-3 s, each step takes 2^21 / 1000 = 2097.152 units,
-    /// 2,097 or 2,098 after the draw's rounding. After 1,999 steps at most 1,999 x 2,098 =
-    /// 4,193,902 are gone, under the whole 2^22 = 4,194,304; after 2,001 at least 2,001 x 2,097
-    /// = 4,196,097.
+    /// at 0.5 per second and steps of 1e-3 s, each step takes 2^22 / 1000 = 4194.304 units,
+    /// 4,194 or 4,195 after the draw's rounding. After 1,999 steps at most 1,999 x 4,195 =
+    /// 8,385,805 are gone, under the whole 2^23 = 8,388,608; after 2,001 at least 2,001 x 4,194
+    /// = 8,392,194.
     #[test]
     fn a_particle_worn_at_a_constant_rate_leaves_when_its_mass_is_gone() {
         let mut units = 0;
@@ -261,7 +271,7 @@ mod tests {
         assert!((7_902..=7_903).contains(&filled), "{filled}");
         let built = exner_pickup(100, 7, 1, -0.5, 1e-3).expect("held");
         assert!((-1_998..=-1_997).contains(&built), "{built}");
-        let whole = PICKUP_WHOLE as i32;
+        let whole = EXNER_WHOLE as i32;
         assert_eq!(exner_pickup(5 - whole, 7, 1, -0.5, 1e-3), Some(-whole));
         assert_eq!(exner_pickup(whole - 10, 7, 1, 0.5, 1e-3), None);
         let worn = exner_pickup(10_000, 7, 1, 0.5, 1e-3).expect("held");
@@ -274,7 +284,7 @@ mod tests {
     /// on; one with 0.25 of a particle's room left, over a step of 0.1 s, keeps 2.5 per second.
     #[test]
     fn a_particle_passes_on_what_it_does_not_keep() {
-        let whole = PICKUP_WHOLE as i32;
+        let whole = EXNER_WHOLE as i32;
         assert_eq!(exner_exchange(3.0, 1.0, 0.5, 0, 1e-3), (1.5, 0.5));
         let (out, net) = exner_exchange(0.2, 1.0, 0.5, 0, 1e-3);
         assert!(
@@ -289,12 +299,16 @@ mod tests {
         );
     }
 
-    /// A word's units come back signed, a surplus as well as a loss, past the region's bits.
+    /// A word's units come back signed under Exner's balance, a surplus as well as a loss,
+    /// past the region's bits; a loss under the pick-up alone, up to its larger whole.
     #[test]
     fn units_round_trip_through_the_word() {
-        let whole = PICKUP_WHOLE as i32;
+        let whole = EXNER_WHOLE as i32;
         for units in [0, 1, -1, whole - 1, -whole, 12_345, -54_321] {
-            assert_eq!(word_units(units_word(units) | 0x1ff), units);
+            assert_eq!(word_units(units_word(units) | 0x1ff, true), units);
+            if units >= 0 {
+                assert_eq!(word_units(units_word(units) | 0x1ff, false), units);
+            }
         }
     }
 }
