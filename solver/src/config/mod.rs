@@ -273,10 +273,11 @@ pub enum Erosion {
     /// bed, where a chance each step lifts a whole particle here and there.
     VanRijnIntegrated,
     /// Worn away as `van_rijn_integrated`, net of the bed load that settles on the particle
-    /// from the one upstream (Exner's balance: what each passes on is its pick-up times van
-    /// Rijn's 1984 saltation length, `physics::sediment::pickup::bed_load_flux`). A bed under a
+    /// from those that pass theirs to it (Exner's balance: what each passes on is the load the
+    /// flow can carry, its pick-up times van Rijn's 1984 saltation length, but no more than it
+    /// was passed plus its pick-up; `physics::sediment::pickup::exner_exchange`). A bed under a
     /// flow the same all along it then neither wears nor roughens; it wears where the flow
-    /// quickens and fills where it slows.
+    /// quickens and builds up where it slows.
     VanRijnExner,
 }
 

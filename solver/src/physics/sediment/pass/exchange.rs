@@ -57,3 +57,46 @@ impl Exchange {
         (self.passed, self.target)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DP: f32 = 0.01;
+
+    /// Particle 5 at the origin under a flow along +x: the point it passes to is (dp, 0).
+    fn at_origin() -> Exchange {
+        Exchange::new(5, [0.0; 3], [1.0, 0.0, 0.0], DP)
+    }
+
+    /// Of two particles as near the point dp downstream, the lower id, in either order; one a
+    /// whole dp from that point, a particle held beneath the next, is not named.
+    #[test]
+    fn names_the_nearest_downstream_the_lower_id_on_a_tie() {
+        let (above, below) = ([DP, 0.3 * DP, 0.0, 0.0], [DP, -0.3 * DP, 0.0, 0.0]);
+        for order in [[(above, 9), (below, 7)], [(below, 7), (above, 9)]] {
+            let mut ex = at_origin();
+            for (x, id) in order {
+                ex.add(&x, id, (0.1, NO_TARGET));
+            }
+            assert_eq!(ex.outcome().1, 7);
+        }
+        let mut ex = at_origin();
+        ex.add(&[DP, -DP, 0.0, 0.0], 3, (0.1, NO_TARGET));
+        assert_eq!(ex.outcome(), (0.0, NO_TARGET), "a dp from the point");
+    }
+
+    /// It is passed the loads of those that named it and of no other; a particle not held at
+    /// the surface in the last pass (`NO_FLUX`) is neither named nor read, and neither is
+    /// itself.
+    #[test]
+    fn is_passed_only_what_was_passed_to_it() {
+        let mut ex = at_origin();
+        ex.add(&[-DP, 0.0, 0.0, 0.0], 1, (0.25, 5));
+        ex.add(&[-DP, DP, 0.0, 0.0], 2, (0.5, 5));
+        ex.add(&[-2.0 * DP, 0.0, 0.0, 0.0], 3, (4.0, 1));
+        ex.add(&[DP, 0.0, 0.0, 0.0], 4, (super::super::NO_FLUX, 5));
+        ex.add(&[0.0; 4], 5, (8.0, 5));
+        assert_eq!(ex.outcome(), (0.75, NO_TARGET));
+    }
+}
