@@ -111,22 +111,24 @@ fn target_slot(step: u32) -> u32 {
     return params.n_particles * (3u + (step & 1u));
 }
 
-// The bed-load exchange of the held surface particle `id_i` at pos_i with its neighbours
-// (`Exchange` of pass.rs), from the last step's pass's fluxes at `slot` and the particles they
-// went to at `to_slot`: the loads of those that named it, and the particle held at the surface
-// nearest the point dp down the flow of the nearest water, within dp of it, that it names.
+// The bed-load exchange of the held particle `id_i` at the bed's top at pos_i with its
+// neighbours (`Exchange` of pass.rs), from the last step's pass's fluxes at `slot` and the
+// particles they went to at `to_slot`: the loads of those that named it, and, if it `names`
+// one (under flowing water), the particle held at the bed's top nearest the point dp down the
+// flow of the nearest water, within dp of it.
 struct Exchanged {
     passed: f32,
     to_id: u32,
 }
 
 fn bed_load_exchange(
-    pos_i: vec3<f32>, id_i: u32, g: Gathered, slot: u32, to_slot: u32
+    pos_i: vec3<f32>, id_i: u32, g: Gathered, names: bool, slot: u32, to_slot: u32
 ) -> Exchanged {
     let dp = params.sediment.dp;
-    let along = g.nearest_u / length(g.nearest_u);
+    let along = select(vec3<f32>(0.0), g.nearest_u / length(g.nearest_u), names);
     let at = pos_i + dp * along;
-    var best_d2 = dp * dp;
+    // Nothing lies nearer the point than 0: a particle under no flow names none.
+    var best_d2 = select(0.0, dp * dp, names);
     var ex = Exchanged(0.0, NO_TARGET);
     let cell = cell_coords(pos_i);
     for (var row = 0u; row < STENCIL_ROWS; row++) {
@@ -160,6 +162,11 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     let tau_y = drucker_prager_yield(rho_i);
     let has_water = g.nearest_r2 < HUGE;
     let at_surface = has_water && g.kernel_mass < sd.surface_mass;
+    // Where bed load is passed on and settles (`at_bed_top` in pass.rs): the surface, or a dry
+    // bed's top, its normal within 45 deg of straight up.
+    let up = g.normal[params.vertical_axis];
+    let faces_up = up > 0.0 && 2.0 * up * up > dot(g.normal, g.normal);
+    let bed_top = at_surface || (g.kernel_mass < sd.surface_mass && faces_up);
     var tau_b = 0.0;
     var tau_bcr = HUGE;
     if (at_surface) {
@@ -192,9 +199,12 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
         let step = state.run_steps + state.steps;
         if (exner) {
             var upstream = 0.0;
-            if (held_before && at_surface && length(g.nearest_u) > 0.0) {
+            if (held_before && bed_top) {
                 let last = step + 1u;
-                let ex = bed_load_exchange(pos_i, ids[i], g, flux_slot(last), target_slot(last));
+                let names = at_surface && length(g.nearest_u) > 0.0;
+                let ex = bed_load_exchange(
+                    pos_i, ids[i], g, names, flux_slot(last), target_slot(last)
+                );
                 upstream = ex.passed;
                 to_id = ex.to_id;
             }
@@ -218,7 +228,8 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     ));
     // What was worn off a particle stays with it while it is held, and only then.
     let kept = select(0, pickup, region == REGION_UNYIELDED && held_before);
-    let passed = exner && !picked && region == REGION_UNYIELDED && at_surface;
+    // Held at the bed's top, wet or dry: what the flow carries to a wet front settles there.
+    let passed = exner && !picked && region == REGION_UNYIELDED && bed_top;
     let mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
     let to = select(NO_TARGET, to_id, passed);
     return Chosen(region, mu, kept, select(NO_FLUX, flux, passed), to);

@@ -95,7 +95,7 @@ pub struct ParticleRheology {
     /// [`EXNER_WHOLE`](super::pickup::EXNER_WHOLE)ths net of what settled on it, negative where
     /// that is more than was worn off (`van_rijn_exner`); 0 otherwise.
     pub pickup: i32,
-    /// The bed load a held particle at the bed's surface passes on downstream, particles per
+    /// The bed load a held particle at the bed's top, wet or dry, passes on downstream, particles per
     /// second (`van_rijn_exner`, [`super::pickup::exner_exchange`] in a pass with draws, else
     /// [`super::pickup::bed_load_flux`]); [`NO_FLUX`] for any other.
     /// The pass's, before any release by the stress of its neighbours (`hold.wgsl` leaves it).
@@ -104,7 +104,7 @@ pub struct ParticleRheology {
     pub target: u32,
 }
 
-/// The flux of a particle that is not held at the bed's surface, or of a pass without
+/// The flux of a particle that is not held at the bed's top, or of a pass without
 /// deposition: no particle downstream reads it.
 pub const NO_FLUX: f32 = -1.0;
 
@@ -577,7 +577,13 @@ impl<'a> Rheology<'a> {
         let held = region == Region::Unyielded;
         // What was worn off a particle stays with it while it is held, and only then.
         let pickup = if held && held_before { pickup } else { 0 };
-        let flux = if held && at_surface { flux } else { NO_FLUX };
+        // A held particle at the bed's top passes on or keeps bed load even where no water
+        // reaches it yet, so what the flow carries to a wet front settles there.
+        let flux = if held && self.at_bed_top(s) {
+            flux
+        } else {
+            NO_FLUX
+        };
         (region as u32, mu.min(model.mu_max), held, (pickup, flux))
     }
 }
@@ -626,21 +632,23 @@ impl Rheology<'_> {
     }
 
     /// The bed-load exchange of sediment particle `id` at `x_i` with its neighbours, when what
-    /// is worn off it is net of what settles on it (`van_rijn_exner`), down the flow of the
-    /// water nearest it, from its sums `s`: if it was held (`before` its word) and lies at the
-    /// bed's surface, in a pass that wears the bed (one with draws; another would not read it).
+    /// is worn off it is net of what settles on it (`van_rijn_exner`), from its sums `s`: if it
+    /// was held (`before` its word) and lies at the bed's top, in a pass that wears the bed (one
+    /// with draws; another would not read it). It passes its load down the flow of the water
+    /// nearest it; one that no flowing water reaches is passed loads and names none.
     pub fn exchange_of(
         &self,
         (x_i, id): (&[f32; 4], u32),
         s: &RheologySums,
         before: u32,
     ) -> Option<Exchange> {
-        let speed = norm3(s.water_u);
         let wears = self.model.exner_step_per_stage > 0.0
             && self.draws.is_some()
             && before & REGION_HELD != 0;
-        (wears && self.at_surface(s) && speed > 0.0 && self.is_sediment(x_i)).then(|| {
-            let along = std::array::from_fn(|k| s.water_u[k] / speed);
+        (wears && self.at_bed_top(s) && self.is_sediment(x_i)).then(|| {
+            let speed = norm3(s.water_u);
+            let along = (self.at_surface(s) && speed > 0.0)
+                .then(|| std::array::from_fn(|k| s.water_u[k] / speed));
             Exchange::new(id, [x_i[0], x_i[1], x_i[2]], along, self.model.dp_m)
         })
     }
@@ -649,6 +657,16 @@ impl Rheology<'_> {
     /// surface fraction of a particle's.
     fn at_surface(&self, s: &RheologySums) -> bool {
         s.water_r < f32::INFINITY && s.kernel_mass < self.reference_mass
+    }
+
+    /// Where bed load is passed on and settles: Eq. 26's surface, or, where no water reaches
+    /// yet, as light a kernel mass under a normal within 45 deg of straight up (the top of a
+    /// dry bed, not its underside or its end face).
+    fn at_bed_top(&self, s: &RheologySums) -> bool {
+        let n = s.normal;
+        let up = n[(self.params.dim - 1) as usize];
+        let faces_up = up > 0.0 && 2.0 * up * up > n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        self.at_surface(s) || (s.kernel_mass < self.reference_mass && faces_up)
     }
 }
 

@@ -4,13 +4,13 @@
 /// end into the pit, or down a step).
 pub const NO_TARGET: u32 = u32::MAX;
 
-/// The bed-load exchange of a held particle at the bed's surface with its neighbours
+/// The bed-load exchange of a held particle at the bed's top with its neighbours
 /// ([`Rheology::exchange_of`](super::Rheology::exchange_of)). It passes its load on to the
-/// particle held at the surface in the last pass nearest the point dp down the flow, within dp
+/// particle held at the bed's top in the last pass nearest the point dp down the flow, within dp
 /// of it (grains picked up from it land one step on), and names that one; it is passed the
 /// loads of every particle that named it in the last pass. Each load thus goes to one particle,
 /// or off the bed, and no sand is counted twice where the bed is uneven. A particle newly at
-/// the surface is named from the pass after.
+/// the top is named from the pass after; one under no flowing water names none.
 #[derive(Clone, Copy, Debug)]
 pub struct Exchange {
     at: [f32; 3],
@@ -21,20 +21,22 @@ pub struct Exchange {
 }
 
 impl Exchange {
-    /// The exchange of particle `id` at `from`, flowed over along the unit vector `along`, on
-    /// a bed of particles `dp` apart.
-    pub(super) fn new(id: u32, from: [f32; 3], along: [f32; 3], dp: f32) -> Exchange {
+    /// The exchange of particle `id` at `from`, flowed over along the unit vector `along`
+    /// (None: under no flowing water), on a bed of particles `dp` apart.
+    pub(super) fn new(id: u32, from: [f32; 3], along: Option<[f32; 3]>, dp: f32) -> Exchange {
+        let flow = along.unwrap_or([0.0; 3]);
         Exchange {
-            at: std::array::from_fn(|k| from[k] + dp * along[k]),
+            at: std::array::from_fn(|k| from[k] + dp * flow[k]),
             id,
-            d2: dp * dp,
+            // Nothing lies nearer the point than 0: a particle under no flow names none.
+            d2: if along.is_some() { dp * dp } else { 0.0 },
             target: NO_TARGET,
             passed: 0.0,
         }
     }
 
     /// Weighs neighbour `id_j` at `x_j`, which in the last pass passed on `flux_j` to
-    /// `target_j` ([`NO_FLUX`](super::NO_FLUX): not a held particle at the surface).
+    /// `target_j` ([`NO_FLUX`](super::NO_FLUX): not a held particle at the bed's top).
     pub fn add(&mut self, x_j: &[f32; 4], id_j: u32, (flux_j, target_j): (f32, u32)) {
         if flux_j < 0.0 || id_j == self.id {
             return;
@@ -66,7 +68,7 @@ mod tests {
 
     /// Particle 5 at the origin under a flow along +x: the point it passes to is (dp, 0).
     fn at_origin() -> Exchange {
-        Exchange::new(5, [0.0; 3], [1.0, 0.0, 0.0], DP)
+        Exchange::new(5, [0.0; 3], Some([1.0, 0.0, 0.0]), DP)
     }
 
     /// Of two particles as near the point dp downstream, the lower id, in either order; one a
@@ -98,5 +100,16 @@ mod tests {
         ex.add(&[DP, 0.0, 0.0, 0.0], 4, (super::super::NO_FLUX, 5));
         ex.add(&[0.0; 4], 5, (8.0, 5));
         assert_eq!(ex.outcome(), (0.75, NO_TARGET));
+    }
+
+    /// Under no flowing water it names none, even a neighbour on its own spot, and is still
+    /// passed what was passed to it.
+    #[test]
+    fn under_no_flow_it_names_none_and_is_passed_its_loads() {
+        let mut ex = Exchange::new(5, [0.0; 3], None, DP);
+        ex.add(&[0.0; 4], 6, (0.0, NO_TARGET));
+        ex.add(&[DP, 0.0, 0.0, 0.0], 7, (0.0, NO_TARGET));
+        ex.add(&[-DP, 0.0, 0.0, 0.0], 1, (0.25, 5));
+        assert_eq!(ex.outcome(), (0.25, NO_TARGET));
     }
 }

@@ -418,3 +418,54 @@ fn bed_load_from_upstream_fills_what_was_worn_then_builds_the_bed() {
     assert!(second[top(0)].pickup <= 1 - whole, "{:?}", second[top(0)]);
     assert_balanced(&second[top(0)], 1000 - whole, 10.0 * e);
 }
+
+/// A wet front: [`worn_bed`] with water over its columns -6 to -1 only. Column 2 is the last
+/// the water's kernel reaches (3.2 dp from the water over column -1, against a support of
+/// 3.4 dp); column 3 and on are dry.
+#[test]
+fn bed_load_carried_to_a_wet_front_settles_on_the_dry_bed_ahead() {
+    let (model, mut pos, mut vel, mut words) = worn_bed(true, 0);
+    for v in [&mut pos, &mut vel] {
+        v.truncate(65 + 6);
+    }
+    words.truncate(65 + 6);
+    let none = (vec![NO_FLUX; pos.len()], vec![NO_TARGET; pos.len()]);
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
+    // The dry top is held and offers to take bed load: a flux of its own, none to pass on.
+    // Its end face and its underside, whose normals lean 45 deg or more from straight up, do
+    // not; nor does the corner between them.
+    for col in 3..=5 {
+        let r = &first[top(col)];
+        assert!(
+            r.held && r.flux == 0.0 && r.pickup == 0,
+            "column {col}: {r:?}"
+        );
+    }
+    let faces = (0..5)
+        .map(|row| top(6) + 13 * row)
+        .chain((3..6).map(|col| top(col) + 13 * 4));
+    for k in faces {
+        assert_eq!(first[k].flux, NO_FLUX, "particle {k}");
+    }
+    let mut fluxes = passed(&wear_for_a_second(
+        &model,
+        (&pos, &vel),
+        (&words, &passed(&first)),
+    ));
+    assert_eq!(
+        fluxes.1[top(2)],
+        top(3) as u32,
+        "the last wet column names the dry one"
+    );
+    // What column 2 passes on settles on column 3, which passes none on.
+    let load = 0.05;
+    fluxes.0[top(2)] = load;
+    let third = wear_for_a_second(&model, (&pos, &vel), (&words, &fluxes));
+    let dry = &third[top(3)];
+    assert!(
+        dry.held && dry.flux == 0.0 && dry.target == NO_TARGET,
+        "{dry:?}"
+    );
+    assert_balanced(dry, 0, load);
+    assert_eq!(third[top(4)].pickup, 0, "passed nothing");
+}
