@@ -26,6 +26,8 @@ const REGION_HELD: u32 = 256u;
 const PICKUP_SHIFT: u32 = 9u;
 const PICKUP_WHOLE: u32 = 8388608u;
 const EXNER_WHOLE: u32 = 4194304u;
+// The units a particle worn whole keeps under Exner's balance (`EXNER_SPENT` of pickup.rs).
+const EXNER_SPENT: i32 = 4194303;
 // The bed load of a particle that is not held at the bed's surface (`NO_FLUX` of pass.rs).
 const NO_FLUX: f32 = -1.0;
 // The particle a held particle passes its bed load to when none is (`NO_TARGET` of pass.rs).

@@ -69,6 +69,9 @@ fn hold(@builtin(global_invocation_id) gid: vec3<u32>) {
     let j2 = 0.5 * (a.x * a.x + a.w * a.w + b.y * b.y) + a.y * a.y + a.z * a.z + b.x * b.x;
     let rho_i = textureLoad(vel_rho, texel(i), 0).w;
     if (sqrt(j2) > FLOW_ONSET * drucker_prager_yield(rho_i)) {
-        regions[ids[i]] = REGION_YIELDED;
+        // Under Exner's balance a released particle carries what was worn off it (hold.rs).
+        let exner = params.sediment.exner_step_per_stage > 0.0;
+        let units = select(0u, regions[ids[i]] & ~((1u << PICKUP_SHIFT) - 1u), exner);
+        regions[ids[i]] = REGION_YIELDED | units;
     }
 }

@@ -197,9 +197,12 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     var to_id = NO_TARGET;
     if (!picked && BEFORE_DT) {
         let step = state.run_steps + state.steps;
-        if (exner) {
+        if (exner && !held_before) {
+            // A grain the bed did not hold carries what was worn off it and wears no more.
+            flux = 0.0;
+        } else if (exner) {
             var upstream = 0.0;
-            if (held_before && bed_top) {
+            if (bed_top) {
                 let last = step + 1u;
                 let names = at_surface && length(g.nearest_u) > 0.0;
                 let ex = bed_load_exchange(
@@ -212,7 +215,7 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
             flux = exchange.x;
             let worn = exner_pickup(pickup, ids[i], step, exchange.y, state.dt_taken);
             picked = worn >= i32(EXNER_WHOLE);
-            pickup = select(worn, 0, picked);
+            pickup = select(worn, EXNER_SPENT, picked);
         } else if (sd.pickup_integrated != 0u) {
             let worn = integrated_pickup(u32(max(pickup, 0)), ids[i], step, rate, state.dt_taken);
             picked = worn >= PICKUP_WHOLE;
@@ -226,8 +229,9 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
         sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
         picked
     ));
-    // What was worn off a particle stays with it while it is held, and only then.
-    let kept = select(0, pickup, region == REGION_UNYIELDED && held_before);
+    // What was worn off a particle stays with it while it is held, and only then; under
+    // Exner's balance, where it went downstream as bed load, wherever the particle goes.
+    let kept = select(0, pickup, exner || (region == REGION_UNYIELDED && held_before));
     // Held at the bed's top, wet or dry: what the flow carries to a wet front settles there.
     let passed = exner && !picked && region == REGION_UNYIELDED && bed_top;
     let mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);

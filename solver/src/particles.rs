@@ -95,8 +95,9 @@ pub struct ParticleRegion {
     pub region: Option<Region>,
     /// Sediment held fixed in the last rheology pass.
     pub held: bool,
-    /// The bits above the hold of a held particle's word, the share of its mass a pick-up worn
-    /// away has taken off it ([`ParticleRegion::worn`]); 0 for a particle not held.
+    /// The bits above the hold, the share of a particle's mass a pick-up worn away has taken
+    /// off it ([`ParticleRegion::worn`]): a held particle's; under `van_rijn_exner` also one
+    /// the bed has released, which carries them; 0 for any other.
     pub worn_bits: u32,
 }
 
@@ -114,14 +115,18 @@ impl ParticleRegion {
         ParticleRegion {
             region,
             held,
-            worn_bits: if held { word >> PICKUP_SHIFT } else { 0 },
+            worn_bits: word >> PICKUP_SHIFT,
         }
     }
 
-    /// The share of a held particle's mass worn off it, in particles: under Exner's balance
-    /// (`exner`, `van_rijn_exner`) net of what settled on it, negative where that is more;
-    /// else by the pick-up alone (`van_rijn_integrated`).
+    /// The share of a particle's mass worn off it, in particles: under Exner's balance
+    /// (`exner`, `van_rijn_exner`) net of what settled on it, negative where that is more, held
+    /// or carried off the bed; else by the pick-up alone (`van_rijn_integrated`), of a held
+    /// particle only.
     pub fn worn(&self, exner: bool) -> f64 {
+        if !(exner || self.held) {
+            return 0.0;
+        }
         let units = word_units(self.worn_bits << PICKUP_SHIFT, exner);
         let whole = if exner { EXNER_WHOLE } else { PICKUP_WHOLE };
         f64::from(units) / f64::from(whole)

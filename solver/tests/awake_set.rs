@@ -96,7 +96,8 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
 
 /// The same under the symplectic scheme, whose corrector's passes read the predictor's holds
 /// and the half step's velocities, with the held bed worn net of what settles from upstream
-/// (`van_rijn_exner`), whose pass reads the bed load its neighbours passed on the step before.
+/// (`van_rijn_exner`), under which no grain sleeps (a dry one takes the load a wet front
+/// carries to it) but the walls do.
 #[test]
 fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
     let case = ulbra(&[

@@ -133,7 +133,7 @@ fn every_constant_stated_on_both_sides_agrees() {
     use flume_solver::contract as c;
     use flume_solver::physics::sediment::{hold, pass, pickup, rheology, shields, suspension};
     use flume_solver::{Health, Region};
-    use naga::Literal::{F32, U32};
+    use naga::Literal::{F32, I32, U32};
     let region = |r: Region| U32(r as u32);
     let checks = [
         (
@@ -213,6 +213,7 @@ fn every_constant_stated_on_both_sides_agrees() {
         ("rheology", "PICKUP_SHIFT", U32(pickup::PICKUP_SHIFT)),
         ("rheology", "PICKUP_WHOLE", U32(pickup::PICKUP_WHOLE)),
         ("rheology", "EXNER_WHOLE", U32(pickup::EXNER_WHOLE)),
+        ("rheology", "EXNER_SPENT", I32(pickup::EXNER_SPENT)),
         ("rheology", "NO_FLUX", F32(pass::NO_FLUX)),
         ("rheology", "NO_TARGET", U32(pass::NO_TARGET)),
         (

@@ -10,9 +10,10 @@
 //! water and no velocity difference: it is not at the surface, its strain rate is zero, its
 //! concentration one, and it stays held with the viscosity its own density gives. That is
 //! what [`Rheology::finish`] gives from the particle's own start, to the bit, without the
-//! neighbour loop (and, not at the surface, it passes no bed load on and reads none from
-//! upstream); its neighbours read only its position, velocity and density, which the pass
-//! does not change. A wall, whose rheology is none, is spared the walk as well.
+//! neighbour loop; its neighbours read only its position, velocity and density, which the
+//! pass does not change. A wall, whose rheology is none, is spared the walk as well. Under
+//! `van_rijn_exner` no grain sleeps: a held grain at a dry bed's top takes the bed load a wet
+//! front carries to it, and passes it on, which its own start cannot tell.
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
@@ -66,8 +67,9 @@ pub fn rheology_pass(
     let held_before = |i: usize| holds.words[i] & REGION_HELD != 0;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = holds.words.len();
-    let stirrers = holds
-        .awake_set
+    // Under Exner's balance a dry held grain at the bed's top takes the load a wet front
+    // carries to it, which its own start cannot tell: no grain sleeps.
+    let stirrers = (holds.awake_set && model.exner_step_per_stage == 0.0)
         .then(|| stirring(params, (pos, vel), holds.words));
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
@@ -155,7 +157,7 @@ fn release_held(
     for (r, _) in out.iter_mut().zip(released).filter(|(_, go)| *go) {
         r.held = false;
         r.region = Region::Yielded as u32;
-        r.pickup = 0;
+        r.pickup = stage.carried(r.pickup);
     }
 }
 

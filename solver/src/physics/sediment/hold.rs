@@ -135,6 +135,17 @@ impl<'a> Release<'a> {
         !self.model.shields_only && rheology.held && phase_index(x) == self.model.sediment_phase
     }
 
+    /// The units a particle released with `units` worn off it keeps: under Exner's balance
+    /// all of them, which went downstream as bed load; by the pick-up alone none, as it is
+    /// released whole.
+    pub fn carried(&self, units: i32) -> i32 {
+        if self.model.exner_step_per_stage > 0.0 {
+            units
+        } else {
+            0
+        }
+    }
+
     /// Adds neighbour j (position, velocity-density, rheology) to a held particle at `x_i`:
     /// only moving sediment within the support counts.
     #[inline(always)]
@@ -197,6 +208,7 @@ pub fn release_pass(
     for i in release {
         rheology[i].held = false;
         rheology[i].region = Region::Yielded as u32;
+        rheology[i].pickup = stage.carried(rheology[i].pickup);
     }
 }
 

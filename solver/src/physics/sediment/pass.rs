@@ -20,8 +20,8 @@
 use super::SedimentParams;
 use super::drucker_prager::{alpha, kappa_c, yield_stress};
 use super::pickup::{
-    bed_load_flux, exner_exchange, exner_pickup, integrated_pickup, picked_up, pickup_rate,
-    units_word, word_units,
+    EXNER_SPENT, bed_load_flux, exner_exchange, exner_pickup, integrated_pickup, picked_up,
+    pickup_rate, units_word, word_units,
 };
 use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
@@ -549,12 +549,15 @@ impl<'a> Rheology<'a> {
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
         let stress = (tau_b, tau_bcr);
-        let (picked_up, pickup, flux) = self.pick_up(
-            word_units(before, model.exner_step_per_stage > 0.0),
-            id,
-            stress,
-            upstream,
-        );
+        let exner = model.exner_step_per_stage > 0.0;
+        let units = word_units(before, exner);
+        // Under Exner's balance a grain the bed did not hold carries what was worn off it, and
+        // wears no more: what the flow carries off a moving grain is the grain.
+        let (picked_up, pickup, flux) = if exner && !held_before {
+            (false, units, 0.0)
+        } else {
+            self.pick_up(units, id, stress, upstream)
+        };
         // The stress the particle carries, which only the Drucker-Prager mode reads.
         let sqrt_j2 = if model.shields_only {
             0.0
@@ -575,8 +578,13 @@ impl<'a> Rheology<'a> {
         });
         let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
         let held = region == Region::Unyielded;
-        // What was worn off a particle stays with it while it is held, and only then.
-        let pickup = if held && held_before { pickup } else { 0 };
+        // What was worn off a particle stays with it while it is held, and only then; under
+        // Exner's balance, where it went downstream as bed load, wherever the particle goes.
+        let pickup = if exner || (held && held_before) {
+            pickup
+        } else {
+            0
+        };
         // A held particle at the bed's top passes on or keeps bed load even where no water
         // reaches it yet, so what the flow carries to a wet front settles there.
         let flux = if held && self.at_bed_top(s) {
@@ -625,9 +633,10 @@ impl Rheology<'_> {
         } else {
             return (picked_up(id, d.step, rate, d.dt_s), 0, NO_FLUX);
         };
+        let spent = if step > 0.0 { EXNER_SPENT } else { 0 };
         match worn {
             Some(units) => (false, units, flux),
-            None => (true, 0, NO_FLUX),
+            None => (true, spent, NO_FLUX),
         }
     }
 

@@ -75,6 +75,11 @@ pub const PICKUP_WHOLE: u32 = 1 << 23;
 /// that a whole particle's surplus fits the signed 23 bits above the hold as well as its loss.
 pub const EXNER_WHOLE: u32 = 1 << 22;
 
+/// The units a particle worn whole keeps under `van_rijn_exner` (all but one of
+/// [`EXNER_WHOLE`], the most the signed bits hold): its mass went downstream as bed load, so
+/// it carries none of its own wherever it goes, until what settles on it makes it sand again.
+pub const EXNER_SPENT: i32 = EXNER_WHOLE as i32 - 1;
+
 /// The units a held particle's word holds: signed, in [`EXNER_WHOLE`]ths, under `exner`; else
 /// in [`PICKUP_WHOLE`]ths.
 pub fn word_units(word: u32, exner: bool) -> i32 {

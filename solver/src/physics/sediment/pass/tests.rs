@@ -469,3 +469,33 @@ fn bed_load_carried_to_a_wet_front_settles_on_the_dry_bed_ahead() {
     assert_balanced(dry, 0, load);
     assert_eq!(third[top(4)].pickup, 0, "passed nothing");
 }
+
+/// Worn whole under Exner's balance, a particle leaves the bed keeping all but a unit of its
+/// wear: its mass went downstream as bed load, so the moving grain carries none of its own.
+/// Not held, it wears no more and keeps its units, where worn by the pick-up alone a released
+/// grain starts whole.
+#[test]
+fn a_grain_worn_whole_carries_its_wear_off_the_bed() {
+    use crate::physics::sediment::pickup::EXNER_SPENT;
+    let whole = EXNER_WHOLE as i32;
+    let (model, pos, vel, words) = worn_bed(true, whole - 10);
+    let none = (vec![NO_FLUX; pos.len()], vec![NO_TARGET; pos.len()]);
+    let first = wear_for_a_second(&model, (&pos, &vel), (&words, &none));
+    let r = &first[top(0)];
+    assert!(!r.held && r.pickup == EXNER_SPENT, "{r:?}");
+    assert_eq!(r.flux, NO_FLUX, "a released particle passes no load on");
+    let words: Words = first.iter().map(ParticleRheology::word).collect();
+    let second = wear_for_a_second(&model, (&pos, &vel), (&words, &passed(&first)));
+    let r = &second[top(0)];
+    assert!(!r.held && r.pickup == EXNER_SPENT, "{r:?}");
+    // A grain the bed does not hold, a third worn, keeps that and wears no more.
+    let mut loose = words.clone();
+    loose[top(0)] = Region::BedLoad as u32 | units_word(whole / 3);
+    let third = wear_for_a_second(&model, (&pos, &vel), (&loose, &passed(&second)));
+    assert_eq!(third[top(0)].pickup, whole / 3, "{:?}", third[top(0)]);
+    // By the pick-up alone it would start whole.
+    let (gross, pos, vel, mut words) = worn_bed(false, 0);
+    words[top(0)] = Region::BedLoad as u32 | units_word(1000);
+    let alone = wear_for_a_second(&gross, (&pos, &vel), (&words, &none));
+    assert_eq!(alone[top(0)].pickup, 0);
+}
