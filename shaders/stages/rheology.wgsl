@@ -111,11 +111,11 @@ fn target_slot(step: u32) -> u32 {
     return params.n_particles * (3u + (step & 1u));
 }
 
-// The bed-load exchange of the held particle `id_i` at the bed's top at pos_i with its
-// neighbours (`Exchange` of pass.rs), from the last step's pass's fluxes at `slot` and the
-// particles they went to at `to_slot`: the loads of those that named it, and, if it `names`
-// one (under flowing water), the particle held at the bed's top nearest the point dp down the
-// flow of the nearest water, within dp of it.
+// The bed-load exchange of sediment particle `id_i` at pos_i with its neighbours (`Exchange`
+// of pass.rs), from the last step's pass's fluxes at `slot` and the particles they went to at
+// `to_slot`: the loads of those that named it, and, if it `names` one (held at the surface
+// under flowing water), the particle at the bed's top nearest the point dp down the flow of
+// the nearest water, within dp of it.
 struct Exchanged {
     passed: f32,
     to_id: u32,
@@ -197,25 +197,25 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     var to_id = NO_TARGET;
     if (!picked && BEFORE_DT) {
         let step = state.run_steps + state.steps;
-        if (exner && !held_before) {
-            // A grain the bed did not hold carries what was worn off it and wears no more.
-            flux = 0.0;
-        } else if (exner) {
-            var upstream = 0.0;
-            if (bed_top) {
-                let last = step + 1u;
-                let names = at_surface && length(g.nearest_u) > 0.0;
-                let ex = bed_load_exchange(
-                    pos_i, ids[i], g, names, flux_slot(last), target_slot(last)
-                );
-                upstream = ex.passed;
-                to_id = ex.to_id;
-            }
-            let exchange = exner_exchange(flux, upstream, rate, pickup, state.dt_taken);
+        if (exner) {
+            // Every grain is passed the loads named to it, wherever it now lies; one the bed
+            // did not hold carries what was worn off it and wears no more (`settle` in pass.rs).
+            let last = step + 1u;
+            let names = held_before && at_surface && length(g.nearest_u) > 0.0;
+            let ex = bed_load_exchange(
+                pos_i, ids[i], g, names, flux_slot(last), target_slot(last)
+            );
+            to_id = ex.to_id;
+            // A held grain nothing holds (tau_bcr 0: the roof of a hole, say) leaves whole.
+            let free = held_before && tau_bcr <= 0.0;
+            let wears = held_before && !free;
+            let own = select(vec2<f32>(0.0), vec2<f32>(flux, rate), wears);
+            let exchange = exner_exchange(own.x, ex.passed, own.y, pickup, state.dt_taken);
             flux = exchange.x;
             let worn = exner_pickup(pickup, ids[i], step, exchange.y, state.dt_taken);
-            picked = worn >= i32(EXNER_WHOLE);
-            pickup = select(worn, EXNER_SPENT, picked);
+            let whole = worn >= i32(EXNER_WHOLE);
+            picked = whole || free;
+            pickup = select(worn, EXNER_SPENT, whole);
         } else if (sd.pickup_integrated != 0u) {
             let worn = integrated_pickup(u32(max(pickup, 0)), ids[i], step, rate, state.dt_taken);
             picked = worn >= PICKUP_WHOLE;
@@ -232,8 +232,9 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     // What was worn off a particle stays with it while it is held, and only then; under
     // Exner's balance, where it went downstream as bed load, wherever the particle goes.
     let kept = select(0, pickup, exner || (region == REGION_UNYIELDED && held_before));
-    // Held at the bed's top, wet or dry: what the flow carries to a wet front settles there.
-    let passed = exner && !picked && region == REGION_UNYIELDED && bed_top;
+    // Held at the bed's top, wet or dry: what the flow carries to a wet front settles there;
+    // one the bed lets go in this pass still passes on what it carries.
+    let passed = exner && bed_top && (held_before || region == REGION_UNYIELDED);
     let mu = region_viscosity(region, ii_d, tau_y, tau_bcr, c_v);
     let to = select(NO_TARGET, to_id, passed);
     return Chosen(region, mu, kept, select(NO_FLUX, flux, passed), to);

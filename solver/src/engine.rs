@@ -88,6 +88,8 @@ pub trait Engine: Send {
     fn inlet_scan(&mut self, spots: &[[f32; 2]], radius: f32) -> Result<InletScan, SolverError>;
     /// Region words by particle id (see `Simulation::regions`).
     fn regions(&self) -> Result<Vec<u32>, SolverError>;
+    /// Sets the region words by particle id, one a particle, as the next pass reads them.
+    fn write_regions(&mut self, words: &[u32]);
     /// Forces of the current state by particle id, and the smallest stable step over
     /// particles before the CFL factor, without advancing.
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError>;

@@ -123,6 +123,11 @@ fn rheology_wears_the_held_bed_net_of_what_settles_as_the_cpu_does() {
 }
 
 #[test]
+fn grains_worn_whole_and_loose_ones_carry_their_wear_as_the_cpu_does() {
+    on_gpu(|b| sand_stages::check_exner_release(b, 27));
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     on_gpu(parked::check_parked_take_no_part);
 }

@@ -246,6 +246,10 @@ impl Engine for CpuEngine {
         Ok(self.regions.clone())
     }
 
+    fn write_regions(&mut self, words: &[u32]) {
+        self.regions.copy_from_slice(words);
+    }
+
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         let (grid, b) = self.sorted();
         let (mut forces, dt_limit) = self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), None);

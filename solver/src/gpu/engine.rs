@@ -189,6 +189,11 @@ impl Engine for GpuEngine {
         Ok(cast_vec(&raw[0]))
     }
 
+    fn write_regions(&mut self, words: &[u32]) {
+        let q = &self.gpu.queue;
+        q.write_buffer(&self.buffers.regions, 0, bytemuck::cast_slice(words));
+    }
+
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         // A chunk that has not ended, so the force pass runs.
         self.write_state(&StepState::chunk(f32::MAX, (0.0, 0.0), (0, 0)));

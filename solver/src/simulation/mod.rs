@@ -533,6 +533,17 @@ impl Simulation {
         self.engine.regions()
     }
 
+    /// Sets the region words by particle id, as the next rheology pass reads them: a held bed
+    /// already worn, for the tests that hold the two backends to the oracle.
+    ///
+    /// Panics unless there is one word a particle (a bug of the caller).
+    pub fn set_regions(&mut self, words: &[u32]) -> Result<(), SolverError> {
+        let n = self.engine.regions()?.len();
+        assert_eq!(words.len(), n, "one region word a particle");
+        self.engine.write_regions(words);
+        Ok(())
+    }
+
     /// Forces and density rates (x, y, z acceleration, d rho/dt) of the current state, in id
     /// order, and the smallest stable step over particles (before the CFL factor), without
     /// advancing: the backend's side of the force-stage tests.

@@ -552,9 +552,10 @@ impl<'a> Rheology<'a> {
         let exner = model.exner_step_per_stage > 0.0;
         let units = word_units(before, exner);
         // Under Exner's balance a grain the bed did not hold carries what was worn off it, and
-        // wears no more: what the flow carries off a moving grain is the grain.
+        // wears no more: what the flow carries off a moving grain is the grain. What was passed
+        // to it settles on it.
         let (picked_up, pickup, flux) = if exner && !held_before {
-            (false, units, 0.0)
+            self.settle(units, id, upstream)
         } else {
             self.pick_up(units, id, stress, upstream)
         };
@@ -586,8 +587,9 @@ impl<'a> Rheology<'a> {
             0
         };
         // A held particle at the bed's top passes on or keeps bed load even where no water
-        // reaches it yet, so what the flow carries to a wet front settles there.
-        let flux = if held && self.at_bed_top(s) {
+        // reaches it yet, so what the flow carries to a wet front settles there; under Exner's
+        // balance one the bed lets go in this pass still passes on what it carries.
+        let flux = if (held || (exner && held_before)) && self.at_bed_top(s) {
             flux
         } else {
             NO_FLUX
@@ -623,6 +625,12 @@ impl Rheology<'_> {
         let Some(d) = self.draws else {
             return (false, units, flux);
         };
+        if step > 0.0 && tau_bcr <= 0.0 {
+            // Nothing holds the grain (`slope_factors`: the roof of a hole, say): it leaves
+            // whole, worn no more, and what was passed to it settles on it.
+            let (_, units, out) = self.settle(units, id, upstream);
+            return (true, units, out);
+        }
         let (worn, flux) = if step > 0.0 {
             let (out, net) = exner_exchange(flux, upstream, rate, units, d.dt_s);
             (exner_pickup(units, id, d.step, net, d.dt_s), out)
@@ -633,31 +641,41 @@ impl Rheology<'_> {
         } else {
             return (picked_up(id, d.step, rate, d.dt_s), 0, NO_FLUX);
         };
-        let spent = if step > 0.0 { EXNER_SPENT } else { 0 };
         match worn {
             Some(units) => (false, units, flux),
-            None => (true, spent, NO_FLUX),
+            None if step > 0.0 => (true, EXNER_SPENT, flux),
+            None => (true, 0, NO_FLUX),
         }
     }
 
+    /// Under `van_rijn_exner`, a particle the bed did not hold, with `units` worn off it: what
+    /// was passed to it, `upstream`, settles on it, up to a whole particle more than its own
+    /// mass (beyond that it passes over it, [`exner_exchange`]); it is picked up of no more.
+    fn settle(&self, units: i32, id: u32, upstream: f32) -> (bool, i32, f32) {
+        let Some(d) = self.draws else {
+            return (false, units, 0.0);
+        };
+        let (out, net) = exner_exchange(0.0, upstream, 0.0, units, d.dt_s);
+        let settled = exner_pickup(units, id, d.step, net, d.dt_s);
+        (false, settled.unwrap_or(EXNER_SPENT), out)
+    }
+
     /// The bed-load exchange of sediment particle `id` at `x_i` with its neighbours, when what
-    /// is worn off it is net of what settles on it (`van_rijn_exner`), from its sums `s`: if it
-    /// was held (`before` its word) and lies at the bed's top, in a pass that wears the bed (one
-    /// with draws; another would not read it). It passes its load down the flow of the water
-    /// nearest it; one that no flowing water reaches is passed loads and names none.
+    /// is worn off it is net of what settles on it (`van_rijn_exner`), from its sums `s`, in a
+    /// pass that wears the bed (one with draws; another would not read it). Every sediment
+    /// particle is passed the loads named to it, wherever it now lies; one held (`before` its
+    /// word) at the bed's surface under flowing water passes its own down that flow.
     pub fn exchange_of(
         &self,
         (x_i, id): (&[f32; 4], u32),
         s: &RheologySums,
         before: u32,
     ) -> Option<Exchange> {
-        let wears = self.model.exner_step_per_stage > 0.0
-            && self.draws.is_some()
-            && before & REGION_HELD != 0;
-        (wears && self.at_bed_top(s) && self.is_sediment(x_i)).then(|| {
+        let wears = self.model.exner_step_per_stage > 0.0 && self.draws.is_some();
+        (wears && self.is_sediment(x_i)).then(|| {
             let speed = norm3(s.water_u);
-            let along = (self.at_surface(s) && speed > 0.0)
-                .then(|| std::array::from_fn(|k| s.water_u[k] / speed));
+            let names = before & REGION_HELD != 0 && self.at_surface(s) && speed > 0.0;
+            let along = names.then(|| std::array::from_fn(|k| s.water_u[k] / speed));
             Exchange::new(id, [x_i[0], x_i[1], x_i[2]], along, self.model.dp_m)
         })
     }

@@ -4,13 +4,14 @@
 /// end into the pit, or down a step).
 pub const NO_TARGET: u32 = u32::MAX;
 
-/// The bed-load exchange of a held particle at the bed's top with its neighbours
-/// ([`Rheology::exchange_of`](super::Rheology::exchange_of)). It passes its load on to the
-/// particle held at the bed's top in the last pass nearest the point dp down the flow, within dp
-/// of it (grains picked up from it land one step on), and names that one; it is passed the
-/// loads of every particle that named it in the last pass. Each load thus goes to one particle,
-/// or off the bed, and no sand is counted twice where the bed is uneven. A particle newly at
-/// the top is named from the pass after; one under no flowing water names none.
+/// The bed-load exchange of a sediment particle with its neighbours
+/// ([`Rheology::exchange_of`](super::Rheology::exchange_of)). Held at the bed's surface under
+/// flowing water, it passes its load on to the particle at the bed's top in the last pass
+/// nearest the point dp down the flow, within dp of it (grains picked up from it land one step
+/// on), and names that one. Every particle is passed the loads of those that named it in the
+/// last pass, whether it is still held or not. Each load thus goes to one particle, or off the
+/// bed, and no sand is counted twice where the bed is uneven. A particle newly at the top is
+/// named from the pass after; one under no flowing water names none.
 #[derive(Clone, Copy, Debug)]
 pub struct Exchange {
     at: [f32; 3],
