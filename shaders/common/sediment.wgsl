@@ -289,16 +289,18 @@ fn bed_load_flux(rate: f32, tau_b: f32, tau_bcr: f32) -> f32 {
 
 // Exner's balance for a held surface particle: what it passes on and what it loses per second,
 // `vec2(out, net)` with `net = out - upstream`: its own bed load `flux` but no more than the
-// load from `upstream` plus its pick-up at `rate`, and what settles on it no more than builds
-// it up to a whole particle more than its own mass (`exner_exchange` in pickup.rs).
+// load from `upstream` plus its pick-up at `rate`, its pick-up no more than is left of it, and
+// what settles on it no more than builds it up to a whole particle more than its own mass
+// (`exner_exchange` in pickup.rs).
 fn exner_exchange(flux: f32, upstream: f32, rate: f32, units: i32, dt: f32) -> vec2<f32> {
     let room = (f32(units) + f32(EXNER_WHOLE)) / (f32(EXNER_WHOLE) * dt);
-    let net = max(min(flux, upstream + rate) - upstream, -room);
+    let left = f32(max(EXNER_SPENT - units, 0)) / (f32(EXNER_WHOLE) * dt);
+    let net = clamp(min(flux, upstream + rate) - upstream, -room, left);
     return vec2<f32>(upstream + net, net);
 }
 
 // The mass worn off a held particle after a step of `dt` with `net` per second worn (negative:
-// settled), from `units` before: EXNER_WHOLE or more once none is left, never below a whole
+// settled), from `units` before: EXNER_SPENT or more once none is left, never below a whole
 // particle's surplus (`exner_pickup` in pickup.rs; the step's share rounded down or up by the
 // particle's draw).
 fn exner_pickup(units: i32, id: u32, step: u32, net: f32, dt: f32) -> i32 {

@@ -213,7 +213,7 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
             let exchange = exner_exchange(own.x, ex.passed, own.y, pickup, state.dt_taken);
             flux = exchange.x;
             let worn = exner_pickup(pickup, ids[i], step, exchange.y, state.dt_taken);
-            let whole = worn >= i32(EXNER_WHOLE);
+            let whole = worn >= EXNER_SPENT;
             picked = whole || free;
             pickup = select(worn, EXNER_SPENT, whole);
         } else if (sd.pickup_integrated != 0u) {

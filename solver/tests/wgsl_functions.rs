@@ -27,8 +27,8 @@ use flume_solver::physics::kernel::Wendland;
 use flume_solver::physics::sediment::drucker_prager::{alpha, kappa_c, yield_stress};
 use flume_solver::physics::sediment::pass::{skeleton_pressure, slope_factors};
 use flume_solver::physics::sediment::pickup::{
-    EXNER_WHOLE, PICKUP_WHOLE, exner_exchange, exner_pickup, integrated_pickup, picked_up,
-    pickup_draw, pickup_rate,
+    EXNER_SPENT, EXNER_WHOLE, PICKUP_WHOLE, exner_exchange, exner_pickup, integrated_pickup,
+    picked_up, pickup_draw, pickup_rate,
 };
 use flume_solver::physics::sediment::rheology::hbp_viscosity;
 use flume_solver::physics::sediment::shields::{critical_shields, friction_velocity};
@@ -457,13 +457,22 @@ fn worn_away_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32
 }
 
 /// `exner_exchange` and `exner_pickup` of both sides: what a held particle passes on and keeps
-/// where it is passed nothing, less than it carries, more, and more than it has room for; and
-/// its units to the unit from a whole particle's surplus to one unit short of its loss, for
+/// where it is passed nothing, less than it carries, more, and more than it has room for, and
+/// one worn nearly or wholly away; and its units to the unit from a whole particle's surplus to
+/// its whole loss, for
 /// losses and gains from none through a fraction of a unit to a whole particle.
 fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]) {
     let whole = EXNER_WHOLE as i32;
     let mut exchanges = Vec::new();
-    for units in [-whole, 1000 - whole, -1, 0, whole / 2] {
+    for units in [
+        -whole,
+        1000 - whole,
+        -1,
+        0,
+        whole / 2,
+        EXNER_SPENT - 1000,
+        EXNER_SPENT,
+    ] {
         for (flux, upstream, rate) in [(0.09, 0.0, 0.05), (0.09, 0.05, 0.05), (0.02, 0.5, 0.05)] {
             for dt in [1e-4f32, 1.0] {
                 exchanges.push([[flux, upstream, rate, dt], [units as f32, 0.0, 0.0, 0.0]]);
@@ -483,7 +492,16 @@ fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]
     );
     let mut cases = Vec::new();
     for &(id, step) in pairs {
-        for units in [-whole, 5 - whole, -1, 0, 1, whole / 2, whole - 1] {
+        for units in [
+            -whole,
+            5 - whole,
+            -1,
+            0,
+            1,
+            whole / 2,
+            EXNER_SPENT - 1,
+            EXNER_SPENT,
+        ] {
             for net in [
                 0.0f32,
                 0.3 / EXNER_WHOLE as f32,
@@ -516,7 +534,7 @@ fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]
         let got = (((got[0] as u32) << 16) | got[1] as u32) as i32;
         let want = exner_pickup(units, id, step, i[1][0], i[1][1]);
         let what = format!("id {id}, step {step}, units {units}, net {}", i[1][0]);
-        assert_eq!(got < whole, want.is_some(), "worn away: {what}");
+        assert_eq!(got < EXNER_SPENT, want.is_some(), "worn away: {what}");
         if let Some(want) = want {
             assert_eq!(got, want, "{what}");
             built += usize::from(want < 0);

@@ -134,27 +134,30 @@ pub fn bed_load_flux(rate: f32, step_per_stage: f32, tau_b: f32, tau_bcr: f32) -
 /// Exner's balance for a held surface particle under `van_rijn_exner`: what it passes on and
 /// what it gains or loses per second (`(out, net)`, `net = out - upstream` always, so no sand is
 /// made or lost between particles). It passes on its own bed load `flux`, but no more than
-/// what comes from `upstream` plus what is picked up of it at `rate`: a bed worn only by the
-/// flow cannot supply more. What settles on it (a negative net) fills what was worn off it and
-/// then builds it up, to at most a whole particle more than its own mass (its `units` before,
-/// in `EXNER_WHOLE`ths, `dt_s` the step); beyond that what comes from upstream passes over it.
+/// what comes from `upstream` plus what is picked up of it at `rate`, and what is picked up of
+/// it no more than is left of it (its `units` worn before, in `EXNER_WHOLE`ths, against
+/// [`EXNER_SPENT`]; `dt_s` the step): a bed worn only by the flow cannot supply more, and a
+/// particle worn whole supplies nothing. What settles on it (a negative net) fills what was
+/// worn off it and then builds it up, to at most a whole particle more than its own mass;
+/// beyond that what comes from upstream passes over it.
 pub fn exner_exchange(flux: f32, upstream: f32, rate: f32, units: i32, dt_s: f32) -> (f32, f32) {
     let room = (units as f32 + EXNER_WHOLE as f32) / (EXNER_WHOLE as f32 * dt_s);
-    let net = (flux.min(upstream + rate) - upstream).max(-room);
+    let left = (EXNER_SPENT - units).max(0) as f32 / (EXNER_WHOLE as f32 * dt_s);
+    let net = (flux.min(upstream + rate) - upstream).clamp(-room, left);
     (upstream + net, net)
 }
 
 /// The mass a held particle has lost to the flow after a step of `dt_s` with `net` per second
 /// worn off it ([`exner_exchange`]: negative where more settles on it than leaves), from the
-/// `units` lost before: None once it reaches the whole particle. What settles builds it up to
-/// a whole particle more than its own mass, and no further. A step's share is rounded down or
-/// up by particle `id`'s draw at run step `step`, as in [`integrated_pickup`].
+/// `units` lost before: None once it is worn whole ([`EXNER_SPENT`]). What settles builds it
+/// up to a whole particle more than its own mass, and no further. A step's share is rounded
+/// down or up by particle `id`'s draw at run step `step`, as in [`integrated_pickup`].
 pub fn exner_pickup(units: i32, id: u32, step: u32, net: f32, dt_s: f32) -> Option<i32> {
     let whole = EXNER_WHOLE as i32;
     let share = (net * dt_s).clamp(-1.0, 1.0) * EXNER_WHOLE as f32;
     let fraction = (pickup_draw(id, step) >> 8) as f32 * (1.0 / 16_777_216.0);
     let total = units + (share + fraction).floor() as i32;
-    (total < whole).then_some(total.max(-whole))
+    (total < EXNER_SPENT).then_some(total.max(-whole))
 }
 
 #[cfg(test)]
@@ -279,6 +282,11 @@ mod tests {
         let whole = EXNER_WHOLE as i32;
         assert_eq!(exner_pickup(5 - whole, 7, 1, -0.5, 1e-3), Some(-whole));
         assert_eq!(exner_pickup(whole - 10, 7, 1, 0.5, 1e-3), None);
+        assert_eq!(
+            exner_pickup(EXNER_SPENT, 7, 1, 0.0, 1e-3),
+            None,
+            "worn whole"
+        );
         let worn = exner_pickup(10_000, 7, 1, 0.5, 1e-3).expect("held");
         assert!((12_097..=12_098).contains(&worn), "{worn}");
     }
@@ -286,7 +294,8 @@ mod tests {
     /// The balance by hand, per second: a particle that could carry 3 with 1 from upstream and
     /// 0.5 picked up of it passes on 1.5 and loses 0.5; one that carries 0.2 of the same 1
     /// keeps 0.8; one already built up to a whole particle more keeps none and passes all 1
-    /// on; one with 0.25 of a particle's room left, over a step of 0.1 s, keeps 2.5 per second.
+    /// on; one with 0.25 of a particle's room left, over a step of 0.1 s, keeps 2.5 per second;
+    /// one worn nearly whole loses no more than is left of it.
     #[test]
     fn a_particle_passes_on_what_it_does_not_keep() {
         let whole = EXNER_WHOLE as i32;
@@ -297,6 +306,14 @@ mod tests {
             "{out} {net}"
         );
         assert_eq!(exner_exchange(0.2, 1.0, 0.5, -whole, 1e-3), (1.0, 0.0));
+        // Worn all but 1,000 units, over 1e-3 s, it can lose no more than 1,000 units' worth
+        // (0.2384 per second, 1000 / 2^22 / 1e-3); worn whole, nothing.
+        let (out, net) = exner_exchange(3.0, 1.0, 0.5, EXNER_SPENT - 1000, 1e-3);
+        assert!(
+            (net - 0.238_419).abs() < 1e-5 && out == 1.0 + net,
+            "{out} {net}"
+        );
+        assert_eq!(exner_exchange(3.0, 1.0, 0.5, EXNER_SPENT, 1e-3), (1.0, 0.0));
         let (out, net) = exner_exchange(0.0, 10.0, 0.5, -3 * whole / 4, 0.1);
         assert!(
             (net + 2.5).abs() < 1e-5 && (out - 7.5).abs() < 1e-5,
