@@ -107,6 +107,11 @@ fn grains_worn_whole_and_loose_ones_carry_their_wear_as_the_oracle_does() {
 }
 
 #[test]
+fn grains_the_stress_releases_carry_their_wear_as_the_oracle_does() {
+    sand_stages::check_release_carries_wear(&CPU, 28);
+}
+
+#[test]
 fn parked_particles_sort_after_every_cell_and_take_no_part() {
     parked::check_parked_take_no_part(&CPU);
 }

@@ -69,8 +69,8 @@ pub fn rheology_pass(
     let n = holds.words.len();
     // Under Exner's balance a dry held grain at the bed's top takes the load a wet front
     // carries to it, which its own start cannot tell: no grain sleeps.
-    let stirrers = (holds.awake_set && model.exner_step_per_stage == 0.0)
-        .then(|| stirring(params, (pos, vel), holds.words));
+    let stirrers =
+        (holds.awake_set && !model.exner()).then(|| stirring(params, (pos, vel), holds.words));
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
     let (vol, (sides, asleep)): (Vec<f32>, (Vec<RheologySide>, Vec<bool>)) = pool.install(|| {

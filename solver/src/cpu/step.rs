@@ -163,10 +163,7 @@ impl CpuEngine {
             self.regions[id as usize] = 0;
         }
         // The bed load of the pass that wore the bed, which the next one settles downstream.
-        let exner = self
-            .sediment
-            .as_ref()
-            .is_some_and(|m| m.exner_step_per_stage > 0.0);
+        let exner = self.sediment.as_ref().is_some_and(|m| m.exner());
         if draws.is_some() && exner {
             for (r, &id) in pass.out.iter().zip(&b.ids) {
                 self.fluxes[id as usize] = (r.flux, r.target);

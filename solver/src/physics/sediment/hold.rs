@@ -139,11 +139,7 @@ impl<'a> Release<'a> {
     /// all of them, which went downstream as bed load; by the pick-up alone none, as it is
     /// released whole.
     pub fn carried(&self, units: i32) -> i32 {
-        if self.model.exner_step_per_stage > 0.0 {
-            units
-        } else {
-            0
-        }
+        if self.model.exner() { units } else { 0 }
     }
 
     /// Adds neighbour j (position, velocity-density, rheology) to a held particle at `x_i`:

@@ -70,6 +70,14 @@ pub struct SedimentModel {
     pub dp_m: f32,
 }
 
+impl SedimentModel {
+    /// Whether a held particle is worn net of the bed load that settles on it
+    /// (`van_rijn_exner`).
+    pub fn exner(&self) -> bool {
+        self.exner_step_per_stage > 0.0
+    }
+}
+
 /// The pick-up draw of a rheology pass: the run's step count (wrapping) and the last step's
 /// length, s. One pass a step draws (the one before the step's size is chosen), so a symplectic
 /// step's second pass takes none.
@@ -549,7 +557,7 @@ impl<'a> Rheology<'a> {
         } = self.shields_chain(s);
         let c_v = volume_fraction(s.sediment_volume, s.mixture_volume);
         let stress = (tau_b, tau_bcr);
-        let exner = model.exner_step_per_stage > 0.0;
+        let exner = model.exner();
         let units = word_units(before, exner);
         // Under Exner's balance a grain the bed did not hold carries what was worn off it, and
         // wears no more: what the flow carries off a moving grain is the grain. What was passed
@@ -671,7 +679,7 @@ impl Rheology<'_> {
         s: &RheologySums,
         before: u32,
     ) -> Option<Exchange> {
-        let wears = self.model.exner_step_per_stage > 0.0 && self.draws.is_some();
+        let wears = self.model.exner() && self.draws.is_some();
         (wears && self.is_sediment(x_i)).then(|| {
             let speed = norm3(s.water_u);
             let names = before & REGION_HELD != 0 && self.at_surface(s) && speed > 0.0;
