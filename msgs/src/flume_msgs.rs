@@ -30,7 +30,8 @@ pub struct BedProfile {
     pub zw_m: Vec<f64>,
 }
 
-/// Eroded sediment (Eq. 34) since the start.
+/// Eroded sediment (Eq. 34) since the start, with the mass worn off the bed as bed load under
+/// `van_rijn_exner` (`ErodedMass.msg`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ErodedMass {
     pub header: Header,

@@ -15,7 +15,7 @@
 //! - **moving**: regions 2 and 3;
 //! - **deposited**: held or un-yielded again on the bed.
 
-use crate::config::{Case, Erosion};
+use crate::config::Case;
 use crate::particles::{ParticleRegion, Particles};
 use crate::physics::sediment::suspension::Region;
 
@@ -84,10 +84,7 @@ impl SedimentBudget {
     pub fn new(case: &Case, initial: &Particles) -> Option<SedimentBudget> {
         let flume = case.open_flume.as_ref()?;
         let (sand, _) = case.sediment_phases()?;
-        let exner = case.phases[sand]
-            .sediment
-            .as_ref()
-            .is_some_and(|s| s.erosion == Erosion::VanRijnExner);
+        let exner = case.wears_by_exner();
         let sand_phase = sand as u32 + 1;
         let grains: Vec<Grain> = (0..initial.len())
             .filter(|&i| initial.phase(i) == sand_phase)

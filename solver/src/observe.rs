@@ -57,7 +57,12 @@ pub struct FlumeObservation {
     pub inflow_m3_per_s: f64,
     /// Sediment particles collected (or gone over the weir) since the start.
     pub eroded_particles: u64,
-    /// Eroded mass per metre of width (Eq. 34), kg/m, and times the flume width, kg.
+    /// Under `van_rijn_exner`, the mass the flow has worn off the sand as bed load, in
+    /// particles: passed over the bed's last held grain into the pit, or carried by grains the
+    /// bed has let go; 0 under any other erosion, whose wear is not conserved.
+    pub worn_particles: f64,
+    /// Eroded mass per metre of width, kg/m, and times the flume width, kg: Eq. 34 on the
+    /// particles collected, plus [`FlumeObservation::worn_particles`].
     pub eroded_kg_per_m: f64,
     pub eroded_kg: f64,
     /// Eroded mass per second since the previous observation, kg/s (whole width).

@@ -534,6 +534,17 @@ impl Case {
         Some((sediment, water))
     }
 
+    /// Whether the sand wears net of what settles on it (`van_rijn_exner`): its region words'
+    /// units are signed, and a grain carries them off the bed.
+    pub fn wears_by_exner(&self) -> bool {
+        self.sediment_phases().is_some_and(|(k, _)| {
+            self.phases[k]
+                .sediment
+                .as_ref()
+                .is_some_and(|s| s.erosion == Erosion::VanRijnExner)
+        })
+    }
+
     /// Whether held sediment stands as a wall (`physics::boundary`): the Shields-only mode's
     /// holds under the generalised wall condition.
     pub fn held_bed_is_wall(&self) -> bool {

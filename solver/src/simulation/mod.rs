@@ -26,6 +26,7 @@ use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
 use crate::particles::{Parking, ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
+use crate::physics::sediment::suspension::Region;
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
@@ -584,19 +585,28 @@ impl Simulation {
                 .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext);
         obs.recoveries = self.recoveries.len() as u32;
         obs.cfl = self.cfl();
-        if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
+        let exner = self.case.wears_by_exner();
+        let mut worn = 0.0;
+        if self.params.viscosity_mode == VISCOSITY_MULTIPHASE || exner {
             let mut counts = [0u32; 6];
             for w in self.regions()? {
-                counts[usize::from(ParticleRegion::from_word(w).number())] += 1;
+                let r = ParticleRegion::from_word(w);
+                counts[usize::from(r.number())] += 1;
+                // Only sand carries wear: walls, parked particles and water have no units.
+                if exner && r.region.is_some_and(|r| r != Region::Water) {
+                    worn += r.worn(true);
+                }
             }
-            obs.region_counts = Some(counts);
+            if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
+                obs.region_counts = Some(counts);
+            }
         }
         if let Some(f) = &self.flume {
             let sediment_mass = self
                 .case
                 .sediment_phases()
                 .map_or(0.0, |(k, _)| self.derived.phases[k + 1].mass);
-            let kg_per_m = f.eroded_kg_per_m(sediment_mass);
+            let kg_per_m = f.eroded_kg_per_m(sediment_mass) + worn * sediment_mass;
             let kg = kg_per_m * f.config.width_m;
             let (t_prev, kg_prev) = self.last_eroded.replace((self.time_s, kg));
             let rate = if self.time_s > t_prev {
@@ -607,6 +617,7 @@ impl Simulation {
             obs.flume = Some(FlumeObservation {
                 inflow_m3_per_s: f.inflow_m3_per_s,
                 eroded_particles: f.eroded_particles,
+                worn_particles: worn,
                 eroded_kg_per_m: kg_per_m,
                 eroded_kg: kg,
                 eroded_rate_kg_per_s: rate,

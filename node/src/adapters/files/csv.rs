@@ -151,7 +151,7 @@ impl<W: Write> ErodedMassCsv<W> {
     pub fn new(mut w: W) -> io::Result<Self> {
         writeln!(
             w,
-            "time_s,inflow_m3_per_s,eroded_particles,eroded_kg_per_m,eroded_kg,eroded_rate_kg_per_s,parked_particles,pores_particles"
+            "time_s,inflow_m3_per_s,eroded_particles,eroded_kg_per_m,eroded_kg,eroded_rate_kg_per_s,parked_particles,pores_particles,worn_particles"
         )?;
         w.flush()?;
         Ok(ErodedMassCsv { w })
@@ -163,7 +163,7 @@ impl<W: Write> ErodedMassCsv<W> {
         };
         writeln!(
             self.w,
-            "{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{}",
             obs.time_s,
             f.inflow_m3_per_s,
             f.eroded_particles,
@@ -171,7 +171,8 @@ impl<W: Write> ErodedMassCsv<W> {
             f.eroded_kg,
             f.eroded_rate_kg_per_s,
             f.parked_particles,
-            f.soaked_particles
+            f.soaked_particles,
+            f.worn_particles
         )?;
         self.w.flush()
     }
