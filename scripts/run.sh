@@ -13,7 +13,7 @@ if [ "$#" -eq 0 ]; then
     --set open_flume.reservoir_particles=2500 \
     --set 'numerics.boundary={method: generalised}' \
     --set 'numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}' \
-    --set phases.1.sediment.erosion=van_rijn_integrated \
+    --set phases.1.sediment.erosion=van_rijn_exner \
     --set phases.1.sediment.shields_speed=water
 fi
 cargo run --release --quiet --bin flume-twin -- "$@"

@@ -93,8 +93,8 @@ pub fn printed(out: &std::process::Output) -> String {
 /// (`scripts/run.sh`): the arguments after the case file. At this dp the flow is two to four
 /// particles deep, and the paper's choices (DBC walls, alpha = 0.02, the release at once) hold
 /// the water 2-3 cm too high and rising; the twin takes the generalised walls, the flow's eddy
-/// viscosity at 2 m3/h, van Rijn's pick-up worn away and the Shields test on the water's own
-/// speed (README, levels section).
+/// viscosity at 2 m3/h, van Rijn's pick-up worn off the bed net of what settles on it (Exner's
+/// balance) and the Shields test on the water's own speed (README, levels section).
 pub const ULBRA_CI: [&str; 12] = [
     "--set",
     "numerics.dp_m=0.01",
@@ -105,7 +105,7 @@ pub const ULBRA_CI: [&str; 12] = [
     "--set",
     "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
     "--set",
-    "phases.1.sediment.erosion=van_rijn_integrated",
+    "phases.1.sediment.erosion=van_rijn_exner",
     "--set",
     "phases.1.sediment.shields_speed=water",
 ];
