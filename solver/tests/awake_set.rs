@@ -75,14 +75,16 @@ fn ulbra(overrides: &[&str]) -> Case {
 }
 
 /// The CI flume as the twin runs it (generalised walls, the held bed a wall, van Rijn's
-/// pick-up): the front crosses 2 m of dry bed in its first 4 s, waking walls and held sand as it
-/// goes, and picks sand up; by 6 s it has gone over the end wall into the pit.
+/// pick-up worn net of what settles, `van_rijn_exner`): the front crosses 2 m of dry bed in its
+/// first 4 s, waking walls and held sand as it goes, and carries the load it picks up to the
+/// dry bed's top ahead of it, whose grains slept until the water came near; by 6 s it has gone
+/// over the end wall into the pit.
 #[test]
 fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
     let case = ulbra(&[
         "numerics.boundary={method: generalised}",
         "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
-        "phases.1.sediment.erosion=van_rijn_integrated",
+        "phases.1.sediment.erosion=van_rijn_exner",
         "phases.1.sediment.shields_speed=water",
     ]);
     let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5, 6.0]);
@@ -95,15 +97,13 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
 }
 
 /// The same under the symplectic scheme, whose corrector's passes read the predictor's holds
-/// and the half step's velocities, with the held bed worn net of what settles from upstream
-/// (`van_rijn_exner`), under which no grain sleeps (a dry one takes the load a wet front
-/// carries to it) but the walls do.
+/// and the half step's velocities, with the pick-up worn away alone (`van_rijn_integrated`).
 #[test]
 fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
     let case = ulbra(&[
         "numerics.boundary={method: generalised}",
         "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
-        "phases.1.sediment.erosion=van_rijn_exner",
+        "phases.1.sediment.erosion=van_rijn_integrated",
         "phases.1.sediment.shields_speed=water",
         "numerics.integrator={method: symplectic}",
     ]);

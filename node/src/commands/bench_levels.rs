@@ -366,11 +366,14 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
         r.m3_per_h,
         d(last.excluded, first.excluded)
     );
+    let (worn, kg_per_m) = obs
+        .flume
+        .as_ref()
+        .map_or((0.0, 0.0), |f| (f.worn_particles, f.eroded_kg_per_m));
     println!(
-        "eroded by t = {:.0} s: {} sand particles in the collector, {:.3} kg/m (Eq. 34)",
-        last.t,
-        last.eroded,
-        obs.flume.as_ref().map_or(0.0, |f| f.eroded_kg_per_m)
+        "eroded by t = {:.0} s: {} sand particles in the collector and {worn:.2} particles' mass \
+         worn off the bed as bed load, {kg_per_m:.3} kg/m (Eq. 34 with the wear)",
+        last.t, last.eroded,
     );
 }
 

@@ -58,6 +58,14 @@ struct State {
     vel_rho_prev: Vec<[f32; 4]>,
 }
 
+/// What a blow-up rolls back to (`Engine::save`, `Engine::restore`).
+struct Snapshot {
+    a: State,
+    regions: Vec<u32>,
+    fluxes: Vec<(f32, u32)>,
+    bed_tops: Vec<u8>,
+}
+
 impl State {
     fn gather(&self, order: &[u32]) -> State {
         State {
@@ -91,7 +99,10 @@ pub struct CpuEngine {
     /// The bed load each held particle at the surface passed on in the last pass that drew
     /// (`van_rijn_exner`), and the id it passed it to, by id; `NO_FLUX` for any other.
     fluxes: Vec<(f32, u32)>,
-    snapshot: (State, Vec<u32>, Vec<(f32, u32)>),
+    /// Under `van_rijn_exner`, where each particle's last walk found it on the bed, by id
+    /// (`multiphase::Holds::bed_tops`).
+    bed_tops: Vec<u8>,
+    snapshot: Snapshot,
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
     seconds: [f64; STAGES.len()],
@@ -132,6 +143,7 @@ impl CpuEngine {
         };
         let regions = vec![0; particles.len()];
         let fluxes = vec![(NO_FLUX, NO_TARGET); particles.len()];
+        let bed_tops = vec![multiphase::BED_UNKNOWN; particles.len()];
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
             pool: Arc::new(pool),
@@ -139,10 +151,16 @@ impl CpuEngine {
             model: params.physics(shape.dim, n_phases),
             shape,
             sediment: sediment.filter(|_| params.viscosity_mode == VISCOSITY_MULTIPHASE),
-            snapshot: (a.clone(), regions.clone(), fluxes.clone()),
+            snapshot: Snapshot {
+                a: a.clone(),
+                regions: regions.clone(),
+                fluxes: fluxes.clone(),
+                bed_tops: bed_tops.clone(),
+            },
             a,
             regions,
             fluxes,
+            bed_tops,
             probe_points: probe_points.to_vec(),
             seconds: [0.0; STAGES.len()],
             awake_set,
@@ -194,15 +212,19 @@ impl Engine for CpuEngine {
     }
 
     fn save(&mut self) {
-        self.snapshot.0.clone_from(&self.a);
-        self.snapshot.1.clone_from(&self.regions);
-        self.snapshot.2.clone_from(&self.fluxes);
+        let s = &mut self.snapshot;
+        s.a.clone_from(&self.a);
+        s.regions.clone_from(&self.regions);
+        s.fluxes.clone_from(&self.fluxes);
+        s.bed_tops.clone_from(&self.bed_tops);
     }
 
     fn restore(&mut self) {
-        self.a.clone_from(&self.snapshot.0);
-        self.regions.clone_from(&self.snapshot.1);
-        self.fluxes.clone_from(&self.snapshot.2);
+        let s = &self.snapshot;
+        self.a.clone_from(&s.a);
+        self.regions.clone_from(&s.regions);
+        self.fluxes.clone_from(&s.fluxes);
+        self.bed_tops.clone_from(&s.bed_tops);
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {
@@ -248,6 +270,8 @@ impl Engine for CpuEngine {
 
     fn write_regions(&mut self, words: &[u32]) {
         self.regions.copy_from_slice(words);
+        // A word set from outside is no walk's: the grain walks before it may sleep.
+        self.bed_tops.fill(multiphase::BED_UNKNOWN);
     }
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {

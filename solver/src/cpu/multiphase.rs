@@ -11,9 +11,15 @@
 //! concentration one, and it stays held with the viscosity its own density gives. That is
 //! what [`Rheology::finish`] gives from the particle's own start, to the bit, without the
 //! neighbour loop; its neighbours read only its position, velocity and density, which the
-//! pass does not change. A wall, whose rheology is none, is spared the walk as well. Under
-//! `van_rijn_exner` no grain sleeps: a held grain at a dry bed's top takes the bed load a wet
-//! front carries to it, and passes it on, which its own start cannot tell.
+//! pass does not change. A wall, whose rheology is none, is spared the walk as well.
+//!
+//! Under `van_rijn_exner` two things of a held grain's rheology depend on its neighbours even
+//! with none of them moving. A grain named in the last pass that drew takes the load passed to
+//! it: it does not sleep. And a grain at the bed's top offers to take load (a flux of 0, not
+//! `NO_FLUX`), which the particle that names a target reads in the next pass that draws; its
+//! own start cannot tell it, but its last walk did ([`Holds::bed_tops`]): its neighbours have
+//! not moved since, for a neighbour that moves is one that stirs. A grain whose last walk is
+//! not known (none yet, or its word set from outside) does not sleep.
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
@@ -42,6 +48,26 @@ pub struct Holds<'a> {
     /// Whether held grains far from anything moving sleep (see the module doc); false: every
     /// grain runs its sums (the full computation the awake set is checked against).
     pub awake_set: bool,
+    /// Under `van_rijn_exner`, whether each particle lay at the bed's top when it last walked
+    /// its neighbours, by id ([`BED_TOP`], [`BED_BELOW`], or [`BED_UNKNOWN`]); empty otherwise.
+    pub bed_tops: &'a [u8],
+}
+
+/// A particle's last walk found it at the bed's top ([`Holds::bed_tops`]).
+pub const BED_TOP: u8 = 2;
+/// A particle's last walk found it off the bed's top.
+pub const BED_BELOW: u8 = 1;
+/// A particle that has not walked since its word was last set.
+pub const BED_UNKNOWN: u8 = 0;
+
+/// What a particle's rheology says of its place on the bed, for [`Holds::bed_tops`]: where
+/// it offers to take bed load, it lies at the bed's top.
+pub fn bed_top_of(r: &ParticleRheology) -> u8 {
+    if r.flux == NO_FLUX {
+        BED_BELOW
+    } else {
+        BED_TOP
+    }
 }
 
 /// The rheology of the active particles, and how many of them (sleeping grains and walls) were
@@ -67,10 +93,17 @@ pub fn rheology_pass(
     let held_before = |i: usize| holds.words[i] & REGION_HELD != 0;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = holds.words.len();
-    // Under Exner's balance a dry held grain at the bed's top takes the load a wet front
-    // carries to it, which its own start cannot tell: no grain sleeps.
-    let stirrers =
-        (holds.awake_set && !model.exner()).then(|| stirring(params, (pos, vel), holds.words));
+    let exner = model.exner();
+    let stirrers = holds
+        .awake_set
+        .then(|| stirring(params, (pos, vel), holds.words));
+    let named = (holds.awake_set && exner).then(|| named(holds.fluxes));
+    // Under Exner's balance a grain sleeps only where its last walk is known and no load was
+    // named to it (see the module doc).
+    let may_sleep = |i: usize| {
+        let id = holds.ids[i] as usize;
+        !exner || (holds.bed_tops[id] != BED_UNKNOWN && named.as_ref().is_some_and(|n| !n[id]))
+    };
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
     let (vol, (sides, asleep)): (Vec<f32>, (Vec<RheologySide>, Vec<bool>)) = pool.install(|| {
@@ -81,7 +114,8 @@ pub fn rheology_pass(
                 let sleeps = held_before(i)
                     && stirrers
                         .as_ref()
-                        .is_some_and(|s| !grid.any_near(s, &side.x));
+                        .is_some_and(|s| !grid.any_near(s, &side.x))
+                    && may_sleep(i);
                 (pass.volume(&pos[i], &vel[i]), (side, sleeps))
             })
             .unzip()
@@ -98,6 +132,7 @@ pub fn rheology_pass(
         fluxes: holds.fluxes,
         words: holds.words,
         asleep: &asleep,
+        bed_tops: exner.then_some(holds.bed_tops),
     };
     // Every slot is written by its block.
     let none = ParticleRheology {
@@ -172,6 +207,17 @@ fn stirring(params: &Params, (pos, vel): (&[[f32; 4]], &[[f32; 4]]), words: &[u3
     Flagged::new(words.len(), |k| !rests(k))
 }
 
+/// By id, whether the last pass that drew named the particle to take another's bed load.
+fn named(fluxes: &[(f32, u32)]) -> Vec<bool> {
+    let mut named = vec![false; fluxes.len()];
+    for &(_, target) in fluxes {
+        if let Some(n) = named.get_mut(target as usize) {
+            *n = true;
+        }
+    }
+    named
+}
+
 /// What a particle that exchanges no bed load is passed, and where its own goes.
 const NONE_PASSED: (f32, u32) = (0.0, NO_TARGET);
 
@@ -194,6 +240,9 @@ struct Pairs<'a> {
     words: &'a [u32],
     /// The grains that may sleep in this pass.
     asleep: &'a [bool],
+    /// Under `van_rijn_exner`, [`Holds::bed_tops`]: a sleeper at the bed's top offers to take
+    /// load.
+    bed_tops: Option<&'a [u8]>,
 }
 
 impl Pairs<'_> {
@@ -218,7 +267,14 @@ impl Pairs<'_> {
                 for i in group.range.clone() {
                     let s = pass.start(&pos[i], &vel[i]);
                     let before = (self.words[i], self.ids[i]);
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
+                    let r = &mut out[i - first];
+                    *r = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
+                    // At rest under no water a grain at the top passes on nothing, and
+                    // offers to take what a wet front brings.
+                    let top = |t: &[u8]| t[self.ids[i] as usize] == BED_TOP;
+                    if self.asleep[i] && self.bed_tops.is_some_and(top) {
+                        r.flux = 0.0;
+                    }
                 }
             } else {
                 let sums = self.group(&group);
@@ -312,6 +368,7 @@ mod tests {
                 fluxes: &fluxes,
                 draws: None,
                 awake_set,
+                bed_tops: &[],
             };
             let (pos, vel) = (&fx.pos, &fx.vel);
             rheology_pass(&pool, params, &fx.sediment, grid, pos, vel, &holds, false).out

@@ -6,7 +6,7 @@
 
 use super::forces::{Extra, force_pass, lane_use, min_dt};
 use super::grid::{Flagged, Grid};
-use super::multiphase::{Holds, rheology_pass};
+use super::multiphase::{BED_UNKNOWN, Holds, bed_top_of, rheology_pass};
 use super::store::{Event, Store, tally};
 use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
 use crate::contract::{SimParams, StepState};
@@ -150,6 +150,7 @@ impl CpuEngine {
             fluxes: &self.fluxes,
             draws,
             awake_set: self.awake_set,
+            bed_tops: &self.bed_tops,
         };
         let release = self.shape.hold;
         let (params, pool) = (&self.model, &self.pool);
@@ -164,6 +165,14 @@ impl CpuEngine {
         }
         // The bed load of the pass that wore the bed, which the next one settles downstream.
         let exner = self.sediment.as_ref().is_some_and(|m| m.exner());
+        if exner {
+            for (r, &id) in pass.out.iter().zip(&b.ids) {
+                self.bed_tops[id as usize] = bed_top_of(r);
+            }
+            for &id in &b.ids[active..] {
+                self.bed_tops[id as usize] = BED_UNKNOWN;
+            }
+        }
         if draws.is_some() && exner {
             for (r, &id) in pass.out.iter().zip(&b.ids) {
                 self.fluxes[id as usize] = (r.flux, r.target);
