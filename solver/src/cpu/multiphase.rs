@@ -97,7 +97,7 @@ pub fn rheology_pass(
     let stirrers = holds
         .awake_set
         .then(|| stirring(params, (pos, vel), holds.words));
-    let named = (holds.awake_set && exner).then(|| named(holds.fluxes));
+    let named = exner.then(|| named(holds.fluxes));
     // Under Exner's balance a grain sleeps only where its last walk is known and no load was
     // named to it (see the module doc).
     let may_sleep = |i: usize| {
@@ -133,6 +133,7 @@ pub fn rheology_pass(
         words: holds.words,
         asleep: &asleep,
         bed_tops: exner.then_some(holds.bed_tops),
+        named: named.as_deref(),
     };
     // Every slot is written by its block.
     let none = ParticleRheology {
@@ -243,6 +244,8 @@ struct Pairs<'a> {
     /// Under `van_rijn_exner`, [`Holds::bed_tops`]: a sleeper at the bed's top offers to take
     /// load.
     bed_tops: Option<&'a [u8]>,
+    /// Under `van_rijn_exner`, whether the last pass that drew named each particle, by id.
+    named: Option<&'a [bool]>,
 }
 
 impl Pairs<'_> {
@@ -295,9 +298,14 @@ impl Pairs<'_> {
     /// each lies within 2 dp of `i`.
     fn exchange(&self, i: usize, s: &RheologySums) -> (f32, u32) {
         let x = &self.pos[i];
-        let Some(mut ex) = self.pass.exchange_of((x, self.ids[i]), s, self.words[i]) else {
+        let id = self.ids[i];
+        let Some(mut ex) = self.pass.exchange_of((x, id), s, self.words[i]) else {
             return NONE_PASSED;
         };
+        // Most of the bed neither names nor was named: nothing to weigh.
+        if !ex.names() && !self.named.is_none_or(|n| n[id as usize]) {
+            return NONE_PASSED;
+        }
         self.grid
             .rows(self.grid.coords(&[x[0], x[1], x[2]]), |range| {
                 for j in range {
@@ -407,5 +415,125 @@ mod tests {
         let sand = (0..n).filter(|&i| fx.pos[i][3].to_bits() == SAND);
         let regions: std::collections::BTreeSet<u32> = sand.map(|i| want[i].region).collect();
         assert!(regions.len() > 1, "{regions:?}");
+    }
+
+    /// Under `van_rijn_exner`, in a pass that draws, every sediment particle takes the load
+    /// the last pass named to it, whether or not it names one itself: on the fixture's held
+    /// bed, each grain of the bottom row (under no water, so it names none) is named by the
+    /// grain above it, and the top row names targets of its own under the moving water. The
+    /// lanes' pass, with the awake set and without, gives each particle's word, flux and target
+    /// as it walks its neighbours alone, its exchange over the same cells.
+    #[test]
+    fn under_exner_a_grain_that_names_none_still_takes_what_was_named_to_it() {
+        use crate::physics::sediment::pickup::word_units;
+        use crate::physics::sediment::pickup::{pickup_per_s, saltation_length_per_stage};
+        let fx = fixture(Viscosity::Multiphase {
+            alpha: 0.05,
+            sps_length2: 0.0,
+        });
+        let mat = crate::physics::sediment::flume_sand();
+        let (rho_s, rho_w, d50) = (
+            f64::from(mat.rho_s),
+            f64::from(mat.rho_w),
+            f64::from(mat.d50_m),
+        );
+        let model = SedimentModel {
+            water_speed: true,
+            pickup_per_s: pickup_per_s(d50, rho_s, rho_w, 1e-6, 9.81, 0.01) as f32,
+            pickup_integrated: true,
+            exner_step_per_stage: (saltation_length_per_stage(d50, rho_s, rho_w, 1e-6, 9.81) / 0.01)
+                as f32,
+            ..fx.sediment.clone()
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of two threads");
+        let n = fx.pos.len();
+        let sand = |i: usize| fx.pos[i][3].to_bits() == SAND;
+        let words: Vec<u32> = (0..n)
+            .map(|i| if sand(i) { REGION_HELD } else { 0 })
+            .collect();
+        let ids: Vec<u32> = (0..n as u32).collect();
+        // The bottom row lies within 0.2 dp of y = 1.5 dp, the row above within 0.2 dp of 2.5.
+        let row = |i: usize, y: f32| sand(i) && (fx.pos[i][1] - y).abs() < 0.0025;
+        let mut fluxes = vec![(NO_FLUX, NO_TARGET); n];
+        let mut named = Vec::new();
+        for d in (0..n).filter(|&d| row(d, 0.015)) {
+            let above = (0..n)
+                .filter(|&k| row(k, 0.025) && fluxes[k].1 == NO_TARGET)
+                .min_by(|&a, &b| {
+                    let dx = |k: usize| (fx.pos[k][0] - fx.pos[d][0]).abs();
+                    dx(a).total_cmp(&dx(b))
+                })
+                .expect("a grain above");
+            fluxes[above] = (0.5, d as u32);
+            named.push(d);
+        }
+        let draws = Some(Draws {
+            step: 3,
+            dt_s: 1.0e-4,
+        });
+        let (params, grid) = (&fx.params, &fx.grid);
+        let pass = Rheology::new(params, &model).with_draws(draws);
+        let want: Vec<ParticleRheology> = (0..n)
+            .map(|i| {
+                let (x, v) = (&fx.pos[i], &fx.vel[i]);
+                let mut s = pass.start(x, v);
+                if params.phases[phase_index(x)].mobile {
+                    let side = pass.side(x, v);
+                    grid.rows(grid.coords(&side.x), |range| {
+                        for j in range {
+                            let vol = pass.volume(&fx.pos[j], &fx.vel[j]);
+                            let j = (&fx.pos[j], &fx.vel[j]);
+                            pass.add_pair_of_volume(&side, j, vol, true, &mut s);
+                        }
+                    });
+                }
+                let exchange =
+                    pass.exchange_of((x, ids[i]), &s, words[i])
+                        .map_or(NONE_PASSED, |mut ex| {
+                            grid.rows(grid.coords(&[x[0], x[1], x[2]]), |range| {
+                                for j in range {
+                                    ex.add(&fx.pos[j], ids[j], fluxes[j]);
+                                }
+                            });
+                            ex.outcome()
+                        });
+                pass.finish(x, v, &s, (words[i], ids[i]), exchange)
+            })
+            .collect();
+        let bed_tops = vec![BED_UNKNOWN; n];
+        let outcome = |r: &[ParticleRheology]| -> Vec<(u32, u32, u32)> {
+            r.iter()
+                .map(|p| (p.word(), p.flux.to_bits(), p.target))
+                .collect()
+        };
+        for awake_set in [false, true] {
+            let holds = Holds {
+                words: &words,
+                ids: &ids,
+                fluxes: &fluxes,
+                draws,
+                awake_set,
+                bed_tops: &bed_tops,
+            };
+            let (pos, vel) = (&fx.pos, &fx.vel);
+            let got = rheology_pass(&pool, params, &model, grid, pos, vel, &holds, false).out;
+            assert!(outcome(&got) == outcome(&want), "awake set {awake_set}");
+        }
+        // Not vacuous: the load settled on every named grain of the bottom row, and the top
+        // row named targets of its own.
+        for &d in &named {
+            assert!(
+                word_units(want[d].word(), true) < 0,
+                "grain {d}: {:?}",
+                want[d]
+            );
+        }
+        assert!(
+            want.iter().any(|r| r.target != NO_TARGET),
+            "none named a target"
+        );
     }
 }

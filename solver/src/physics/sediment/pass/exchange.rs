@@ -19,6 +19,7 @@ pub struct Exchange {
     d2: f32,
     target: u32,
     passed: f32,
+    names: bool,
 }
 
 impl Exchange {
@@ -33,6 +34,7 @@ impl Exchange {
             d2: if along.is_some() { dp * dp } else { 0.0 },
             target: NO_TARGET,
             passed: 0.0,
+            names: along.is_some(),
         }
     }
 
@@ -52,6 +54,13 @@ impl Exchange {
             self.d2 = d2;
             self.target = id_j;
         }
+    }
+
+    /// Whether the particle passes its load to one it names (it lies under flowing water).
+    /// One that does not, and that no particle named in the last pass, is passed nothing and
+    /// names none: its outcome is known without weighing its neighbours.
+    pub fn names(&self) -> bool {
+        self.names
     }
 
     /// The bed load passed to the particle in the last pass, particles per second, and the
