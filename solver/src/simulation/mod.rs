@@ -26,7 +26,6 @@ use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
 use crate::particles::{Parking, ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
-use crate::physics::sediment::suspension::Region;
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
@@ -577,6 +576,26 @@ impl Simulation {
         &self.params
     }
 
+    /// Under `van_rijn_exner`, the mass worn off the sand as bed load, in particles, from the
+    /// region words `words` (by id) of the particles that are sand now: a grain collected in the
+    /// last step keeps its word until the next rheology pass, and it is counted collected. 0
+    /// under any other erosion, whose wear is not conserved.
+    fn worn_grains(&self, words: &[u32]) -> Result<f64, SolverError> {
+        let sand = match self.case.sediment_phases() {
+            Some((k, _)) if self.case.wears_by_exner() => k as u32 + 1,
+            _ => return Ok(0.0),
+        };
+        let raw = self.engine.read_state()?;
+        let worn = raw
+            .positions
+            .iter()
+            .zip(&raw.ids)
+            .filter(|(x, _)| x[3].to_bits() == sand)
+            .map(|(_, &id)| ParticleRegion::from_word(words[id as usize]).worn(true))
+            .sum();
+        Ok(worn)
+    }
+
     /// Gauges, probes, front and health at the current time.
     pub fn observe(&self) -> Result<Observations, SolverError> {
         let (sums, ext) = self.engine.observe()?;
@@ -585,21 +604,16 @@ impl Simulation {
                 .observations(self.time_s, self.steps, self.last_dt_s, &sums, &ext);
         obs.recoveries = self.recoveries.len() as u32;
         obs.cfl = self.cfl();
-        let exner = self.case.wears_by_exner();
+        // Without the multiphase viscosity no particle has a region, nor any wear.
         let mut worn = 0.0;
-        if self.params.viscosity_mode == VISCOSITY_MULTIPHASE || exner {
+        if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
+            let words = self.regions()?;
             let mut counts = [0u32; 6];
-            for w in self.regions()? {
-                let r = ParticleRegion::from_word(w);
-                counts[usize::from(r.number())] += 1;
-                // Only sand carries wear: walls, parked particles and water have no units.
-                if exner && r.region.is_some_and(|r| r != Region::Water) {
-                    worn += r.worn(true);
-                }
+            for &w in &words {
+                counts[usize::from(ParticleRegion::from_word(w).number())] += 1;
             }
-            if self.params.viscosity_mode == VISCOSITY_MULTIPHASE {
-                obs.region_counts = Some(counts);
-            }
+            obs.region_counts = Some(counts);
+            worn = self.worn_grains(&words)?;
         }
         if let Some(f) = &self.flume {
             let sediment_mass = self
