@@ -349,8 +349,33 @@ impl Pairs<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cpu::fixture::{SAND, fixture};
+    use crate::cpu::fixture::{Fixture, SAND, fixture};
     use crate::physics::Viscosity;
+
+    fn two_threads() -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of two threads")
+    }
+
+    /// Particle `i`'s sums as it walks its neighbours alone over `Grid::rows`, each pair by
+    /// the f32 formulas.
+    fn own_sums(fx: &Fixture, pass: &Rheology, i: usize) -> RheologySums {
+        let (x, v) = (&fx.pos[i], &fx.vel[i]);
+        let mut s = pass.start(x, v);
+        if fx.params.phases[phase_index(x)].mobile {
+            let side = pass.side(x, v);
+            fx.grid.rows(fx.grid.coords(&side.x), |range| {
+                for j in range {
+                    let vol = pass.volume(&fx.pos[j], &fx.vel[j]);
+                    let j = (&fx.pos[j], &fx.vel[j]);
+                    pass.add_pair_of_volume(&side, j, vol, true, &mut s);
+                }
+            });
+        }
+        s
+    }
 
     #[test]
     fn each_lane_gets_the_rheology_of_its_particle_alone() {
@@ -358,10 +383,7 @@ mod tests {
             alpha: 0.05,
             sps_length2: 0.0,
         });
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .expect("a pool of two threads");
+        let pool = two_threads();
         let n = fx.pos.len();
         let held: Vec<u32> = (0..n)
             .map(|i| if i % 3 == 0 { REGION_HELD } else { 0 })
@@ -382,21 +404,10 @@ mod tests {
             rheology_pass(&pool, params, &fx.sediment, grid, pos, vel, &holds, false).out
         };
         let pass = Rheology::new(params, &fx.sediment);
-        // Particle by particle over `Grid::rows`, each pair by the f32 formulas.
         let want: Vec<ParticleRheology> = (0..n)
             .map(|i| {
+                let s = own_sums(&fx, &pass, i);
                 let (x, v) = (&fx.pos[i], &fx.vel[i]);
-                let mut s = pass.start(x, v);
-                if params.phases[phase_index(x)].mobile {
-                    let side = pass.side(x, v);
-                    grid.rows(grid.coords(&side.x), |range| {
-                        for j in range {
-                            let vol = pass.volume(&fx.pos[j], &fx.vel[j]);
-                            let j = (&fx.pos[j], &fx.vel[j]);
-                            pass.add_pair_of_volume(&side, j, vol, true, &mut s);
-                        }
-                    });
-                }
                 pass.finish(x, v, &s, (held[i], ids[i]), NONE_PASSED)
             })
             .collect();
@@ -426,29 +437,12 @@ mod tests {
     #[test]
     fn under_exner_a_grain_that_names_none_still_takes_what_was_named_to_it() {
         use crate::physics::sediment::pickup::word_units;
-        use crate::physics::sediment::pickup::{pickup_per_s, saltation_length_per_stage};
         let fx = fixture(Viscosity::Multiphase {
             alpha: 0.05,
             sps_length2: 0.0,
         });
-        let mat = crate::physics::sediment::flume_sand();
-        let (rho_s, rho_w, d50) = (
-            f64::from(mat.rho_s),
-            f64::from(mat.rho_w),
-            f64::from(mat.d50_m),
-        );
-        let model = SedimentModel {
-            water_speed: true,
-            pickup_per_s: pickup_per_s(d50, rho_s, rho_w, 1e-6, 9.81, 0.01) as f32,
-            pickup_integrated: true,
-            exner_step_per_stage: (saltation_length_per_stage(d50, rho_s, rho_w, 1e-6, 9.81) / 0.01)
-                as f32,
-            ..fx.sediment.clone()
-        };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .expect("a pool of two threads");
+        let model = fx.sediment.clone().worn_by_van_rijn(true);
+        let pool = two_threads();
         let n = fx.pos.len();
         let sand = |i: usize| fx.pos[i][3].to_bits() == SAND;
         let words: Vec<u32> = (0..n)
@@ -478,18 +472,8 @@ mod tests {
         let pass = Rheology::new(params, &model).with_draws(draws);
         let want: Vec<ParticleRheology> = (0..n)
             .map(|i| {
+                let s = own_sums(&fx, &pass, i);
                 let (x, v) = (&fx.pos[i], &fx.vel[i]);
-                let mut s = pass.start(x, v);
-                if params.phases[phase_index(x)].mobile {
-                    let side = pass.side(x, v);
-                    grid.rows(grid.coords(&side.x), |range| {
-                        for j in range {
-                            let vol = pass.volume(&fx.pos[j], &fx.vel[j]);
-                            let j = (&fx.pos[j], &fx.vel[j]);
-                            pass.add_pair_of_volume(&side, j, vol, true, &mut s);
-                        }
-                    });
-                }
                 let exchange =
                     pass.exchange_of((x, ids[i]), &s, words[i])
                         .map_or(NONE_PASSED, |mut ex| {

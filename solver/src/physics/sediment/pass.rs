@@ -76,6 +76,25 @@ impl SedimentModel {
     pub fn exner(&self) -> bool {
         self.exner_step_per_stage > 0.0
     }
+
+    /// This model worn by van Rijn's pick-up on a bed of particles 1 cm apart in water of
+    /// kinematic viscosity 1e-6 m2/s (`van_rijn_exner` with `exner`, else
+    /// `van_rijn_integrated`), the Shields test on the water's speed: the unit tests' bed.
+    #[cfg(test)]
+    pub(crate) fn worn_by_van_rijn(self, exner: bool) -> SedimentModel {
+        use super::pickup::{pickup_per_s, saltation_length_per_stage};
+        let (dp, nu_w) = (0.01, 1e-6);
+        let m = &self.material;
+        let (rho_s, rho_w, d50) = (f64::from(m.rho_s), f64::from(m.rho_w), f64::from(m.d50_m));
+        let step = saltation_length_per_stage(d50, rho_s, rho_w, nu_w, 9.81) / dp;
+        SedimentModel {
+            water_speed: true,
+            pickup_per_s: pickup_per_s(d50, rho_s, rho_w, nu_w, 9.81, dp) as f32,
+            pickup_integrated: true,
+            exner_step_per_stage: if exner { step as f32 } else { 0.0 },
+            ..self
+        }
+    }
 }
 
 /// The pick-up draw of a rheology pass: the run's step count (wrapping) and the last step's

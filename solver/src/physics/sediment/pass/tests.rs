@@ -219,22 +219,7 @@ fn skeleton_pressure_is_effective_stress_at_the_surface() {
 /// (`van_rijn_exner` with `exner`, else `van_rijn_integrated`): positions, velocities, and
 /// the region words of a bed held with `worn` of each particle worn off.
 fn worn_bed(exner: bool, worn: i32) -> (SedimentModel, Vec<[f32; 4]>, Vec<[f32; 4]>, Words) {
-    use crate::physics::sediment::pickup::{pickup_per_s, saltation_length_per_stage};
-    let dp = 0.01;
-    let mat = crate::physics::sediment::flume_sand();
-    let (rho_s, rho_w, nu_w) = (f64::from(mat.rho_s), f64::from(mat.rho_w), 1e-6);
-    let d50 = f64::from(mat.d50_m);
-    let model = SedimentModel {
-        water_speed: true,
-        pickup_per_s: pickup_per_s(d50, rho_s, rho_w, nu_w, 9.81, dp) as f32,
-        pickup_integrated: true,
-        exner_step_per_stage: if exner {
-            (saltation_length_per_stage(d50, rho_s, rho_w, nu_w, 9.81) / dp) as f32
-        } else {
-            0.0
-        },
-        ..flume_case().1
-    };
+    let model = flume_case().1.worn_by_van_rijn(exner);
     let at = |col: i32, y: f32, phase: u32| [col as f32 * 0.01, y, 0.0, f32::from_bits(phase)];
     let (mut pos, mut vel, mut words) = (Vec::new(), Vec::new(), Vec::new());
     for row in 0..5 {
