@@ -14,6 +14,8 @@
 //!   discharge asked (particles parked at the outlet, dp^2 each per metre of width);
 //! - the run in 10 s windows from its start, the case's gauges' levels and the weir's
 //!   discharge in each, and the window from which it stayed steady (`bench_steadiness`);
+//! - the run from 40 s to its end as one stretch: each gauge's trend by least squares and the
+//!   weir over the whole stretch, the issue's drift and outflow read with the least noise;
 //! - at the end, the pool gauge's column: what it passes, and the weir's head counted as energy
 //!   against the rating's over an even approach (a current that has not spread down carries
 //!   velocity head where a still pool holds level);
@@ -26,13 +28,13 @@
 //!
 //! Nothing is asserted: the figures are for the log and the issue's goals.
 
-use super::bench_steadiness::{self, Window};
+use super::bench_steadiness::{self, SETTLED_BY_S, Settled, Window};
 use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
 use flume_solver::bed_contact::bed_contact;
 use flume_solver::config::GaugeConfig;
 use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, PitFlow, SideWalls, fixed_bed_overrides};
-use flume_solver::{Backend, Case, Observations, Particles, Simulation};
+use flume_solver::{Backend, Case, Observations, ParticleRegion, Particles, Simulation};
 use std::path::Path;
 use std::time::Instant;
 
@@ -185,10 +187,14 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
         .map(|(k, g)| (k, g.name.clone()))
         .unzip();
     bench_steadiness::print(&names, &windows(case, r, &own, &history));
+    if let Some(settled) = settled(case, r, &own, &history) {
+        settled.print(&names);
+    }
     let particles = sim.read_particles()?;
     // Particles come in id order, as the region words do.
     let regions = sim.regions()?;
     print_bed(&sim, case, &particles, &regions);
+    print_loose_sand(case, channel, &particles, &regions);
     print_pool(case, channel, r, &history, &particles);
     Ok(())
 }
@@ -319,6 +325,44 @@ fn windows(
     out
 }
 
+/// The run from [`SETTLED_BY_S`] to its end as one stretch, each gauge of `gauges` (indices)
+/// observation by observation; `None` for a run that ends within a window of it.
+fn settled(
+    case: &Case,
+    r: &LevelRun,
+    gauges: &[usize],
+    history: &[(Books, Observations)],
+) -> Option<Settled> {
+    if r.until_s < SETTLED_BY_S + WINDOW_S - 1e-6 {
+        return None;
+    }
+    let (first, _) = at(history, SETTLED_BY_S)?;
+    let (last, _) = history.last()?;
+    let span = last.t - first.t;
+    if span <= 0.0 {
+        return None;
+    }
+    let dp = case.numerics.dp_m;
+    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
+    let asked = r.m3_per_h / 3600.0 / width;
+    let stretch = history.iter().filter(|(b, _)| b.t > first.t + 1e-6);
+    let levels_m = gauges
+        .iter()
+        .map(|&g| {
+            stretch
+                .clone()
+                .map(|(b, o)| (b.t, o.gauges.get(g).and_then(|x| x.level_m)))
+                .collect()
+        })
+        .collect();
+    Some(Settled {
+        from_s: first.t,
+        to_s: last.t,
+        levels_m,
+        over_weir: last.since(first).1 * dp * dp / span / asked,
+    })
+}
+
 /// The 1-D reference's geometry, weir, friction, pit and eddy viscosity at discharge `q`
 /// (m3/s) over `width` (m).
 fn print_reference(channel: &Channel, q: f64, width: f64) {
@@ -374,6 +418,58 @@ fn print_flow(case: &Case, r: &LevelRun, history: &[(Books, Observations)]) {
         "eroded by t = {:.0} s: {} sand particles in the collector and {worn:.2} particles' mass \
          worn off the bed as bed load, {kg_per_m:.3} kg/m (Eq. 34 with the wear)",
         last.t, last.eroded,
+    );
+}
+
+/// The sand the collector has not taken that stands out of the bed, by x: its centre over the
+/// bed's surface, or past the bed's end (the sill's downstream face); whether each is held. A
+/// held grain there is a wall as high as a third of the flow at dp = 1 cm.
+fn loose_sand(
+    case: &Case,
+    channel: &Channel,
+    particles: &Particles,
+    regions: &[u32],
+) -> Vec<(f32, f32, bool)> {
+    let Some((sand, _)) = case.sediment_phases() else {
+        return Vec::new();
+    };
+    let out_of_bed =
+        |x: [f32; 4]| f64::from(x[1]) > channel.bed_m || f64::from(x[0]) > channel.x_bed_end_m;
+    let mut loose: Vec<(f32, f32, bool)> = (0..particles.len())
+        // Phase codes are the case's indices plus one (`Particles::phase`).
+        .filter(|&i| particles.phase(i) == sand as u32 + 1)
+        .filter(|&i| out_of_bed(particles.positions[i]))
+        .map(|i| {
+            let held = regions
+                .get(i)
+                .is_some_and(|&w| ParticleRegion::from_word(w).held);
+            (particles.positions[i][0], particles.positions[i][1], held)
+        })
+        .collect();
+    loose.sort_by(|a, b| a.0.total_cmp(&b.0));
+    loose
+}
+
+fn print_loose_sand(case: &Case, channel: &Channel, particles: &Particles, regions: &[u32]) {
+    let loose = loose_sand(case, channel, particles, regions);
+    let listed: Vec<String> = loose
+        .iter()
+        .map(|(x, y, held)| {
+            let how = if *held { "held" } else { "moving" };
+            format!("({x:.3}, {y:.3}) m {how}")
+        })
+        .collect();
+    let tail = if listed.is_empty() {
+        String::new()
+    } else {
+        format!(": {}", listed.join(", "))
+    };
+    println!(
+        "sand out of the bed (its centre over the surface at {:.3} m, or past the bed's end at \
+         {:.2} m), not collected: {}{tail}",
+        channel.bed_m,
+        channel.x_bed_end_m,
+        loose.len(),
     );
 }
 
@@ -529,6 +625,41 @@ mod tests {
             ..first
         };
         assert_eq!(stored.since(&first), (646.0, 0.0));
+    }
+
+    /// Of five particles of the CI flume (bed surface 0.055 m, the bed's end 2.23 m): sand in
+    /// the top row, a held grain on it, a grain moving in the pit, water over the bed and a
+    /// wall past the end. The two grains out of the bed, by x; a grain in the top row, or water
+    /// or a wall, listed, or the phase codes read as the case's indices, gives another list.
+    #[test]
+    fn the_sand_out_of_the_bed_is_listed_by_x() {
+        let flume =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+        let run = LevelRun {
+            dp_m: 0.01,
+            m3_per_h: 2.0,
+            until_s: 30.0,
+            fixed_bed: false,
+        };
+        let (case, channel) = level_case(&flume, &[], &run).expect("the CI flume");
+        assert!((channel.bed_m - 0.055).abs() < 1e-9, "{}", channel.bed_m);
+        let code = |phase: u32| f32::from_bits(phase);
+        let (water, sand) = (code(1), code(2));
+        let particles = Particles {
+            positions: vec![
+                [1.005, 0.050, 0.0, sand],
+                [2.305, 0.030, 0.0, sand],
+                [2.163, 0.061, 0.0, sand],
+                [1.5, 0.065, 0.0, water],
+                [2.505, 0.040, 0.0, code(flume_solver::particles::WALL_PHASE)],
+            ],
+            vel_rho: vec![[0.0; 4]; 5],
+            ids: (0..5).collect(),
+        };
+        // Region 1 held (`REGION_HELD`, 256), region 3 (bed load), water, a wall.
+        let regions = [1 | 256, 3, 1 | 256, 5, 0];
+        let loose = loose_sand(&case, &channel, &particles, &regions);
+        assert_eq!(loose, vec![(2.163, 0.061, true), (2.305, 0.030, false)]);
     }
 
     /// The reservoir is sized for the stored water unless `--set` sizes it; the resolution,
