@@ -10,6 +10,8 @@ mod adapters;
 #[allow(rustdoc::invalid_html_tags)]
 mod cli;
 mod commands;
+#[cfg(test)]
+mod test_support;
 mod twin;
 
 use clap::Parser;

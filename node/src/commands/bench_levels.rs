@@ -293,9 +293,6 @@ fn windows(
     gauges: &[usize],
     history: &[(Books, Observations)],
 ) -> Vec<Window> {
-    let dp = case.numerics.dp_m;
-    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
-    let asked = r.m3_per_h / 3600.0 / width;
     let mut out = Vec::new();
     let mut from = 0.0;
     while from + WINDOW_S <= r.until_s + 1e-6 {
@@ -305,11 +302,9 @@ fn windows(
             break;
         };
         // The first window's books start at the first observation.
-        let span = last.t - first.t;
-        if span <= 0.0 {
+        let Some(over_weir) = weir_share(case, r, first, last) else {
             break;
-        }
-        let over_weir = last.since(first).1 * dp * dp / span / asked;
+        };
         let levels_m = gauges
             .iter()
             .map(|&g| mean_level(history, g, from, to))
@@ -338,13 +333,7 @@ fn settled(
     }
     let (first, _) = at(history, SETTLED_BY_S)?;
     let (last, _) = history.last()?;
-    let span = last.t - first.t;
-    if span <= 0.0 {
-        return None;
-    }
-    let dp = case.numerics.dp_m;
-    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
-    let asked = r.m3_per_h / 3600.0 / width;
+    let over_weir = weir_share(case, r, first, last)?;
     let stretch = history.iter().filter(|(b, _)| b.t > first.t + 1e-6);
     let levels_m = gauges
         .iter()
@@ -359,8 +348,21 @@ fn settled(
         from_s: first.t,
         to_s: last.t,
         levels_m,
-        over_weir: last.since(first).1 * dp * dp / span / asked,
+        over_weir,
     })
+}
+
+/// The discharge over the weir from `first` to `last` over the one asked (particles parked at
+/// the outlet, dp^2 each per metre of width); `None` over no time.
+fn weir_share(case: &Case, r: &LevelRun, first: &Books, last: &Books) -> Option<f64> {
+    let span = last.t - first.t;
+    if span <= 0.0 {
+        return None;
+    }
+    let dp = case.numerics.dp_m;
+    let width = case.open_flume.as_ref().map_or(1.0, |f| f.width_m);
+    let asked = r.m3_per_h / 3600.0 / width;
+    Some(last.since(first).1 * dp * dp / span / asked)
 }
 
 /// The 1-D reference's geometry, weir, friction, pit and eddy viscosity at discharge `q`
@@ -627,20 +629,87 @@ mod tests {
         assert_eq!(stored.since(&first), (646.0, 0.0));
     }
 
+    /// The bundled flume's case file, and a run of it at dp = 1 cm and 2 m3/h to `until_s`.
+    fn ci_flume(until_s: f64) -> (std::path::PathBuf, LevelRun) {
+        let flume =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
+        let run = LevelRun {
+            dp_m: 0.01,
+            m3_per_h: 2.0,
+            until_s,
+            fixed_bed: false,
+        };
+        (flume, run)
+    }
+
+    /// An observation of the gauges' `levels` alone.
+    fn gauges_at(t: f64, levels: &[Option<f64>]) -> Observations {
+        let gauges = levels
+            .iter()
+            .map(|&level_m| flume_solver::GaugeReading {
+                name: "g".to_string(),
+                level_m,
+            })
+            .collect();
+        Observations {
+            gauges,
+            ..crate::test_support::observations_at(t)
+        }
+    }
+
+    /// A run to 60 s observed every second: until 40 s the flume stores its inflow and P1
+    /// stands at 70 mm; after, the weir passes 66 particles a second (the inflow asked is 64.6:
+    /// 6.46e-3 m2/s over dp^2) and P1 rises 0.1 mm a second from 80 mm. The stretch starts at the
+    /// observation of 40 s and holds the 20 after it: its trend is 1 mm per 10 s and its weir
+    /// 66 / 64.6 of the inflow. Taking the 40 s observation in, or the books from another,
+    /// gives other figures.
+    #[test]
+    fn the_settled_stretch_starts_at_40_s() {
+        let (flume, run) = ci_flume(60.0);
+        let (case, _) = level_case(&flume, &[], &run).expect("the CI flume");
+        let history: Vec<(Books, Observations)> = (1..=60u64)
+            .map(|t| {
+                let out = 66 * t.saturating_sub(40);
+                let books = Books {
+                    t: t as f64,
+                    parked: 10_000 - 65 * t + out,
+                    injected: 65 * t,
+                    eroded: 0,
+                    excluded: 0,
+                    soaked: 0,
+                };
+                let level = if t > 40 {
+                    0.080 + 1e-4 * (t - 40) as f64
+                } else {
+                    0.070
+                };
+                (books, gauges_at(t as f64, &[Some(level)]))
+            })
+            .collect();
+        let s = settled(&case, &run, &[0], &history).expect("a stretch");
+        assert_eq!((s.from_s, s.to_s, s.levels_m[0].len()), (40.0, 60.0, 20));
+        let trend = s.trends()[0].expect("wet");
+        assert!((trend - 1e-3).abs() < 1e-12, "{trend}");
+        let asked = 2.0 / 3600.0 / 0.086;
+        assert!(
+            (s.over_weir - 66e-4 / asked).abs() < 1e-9,
+            "{}",
+            s.over_weir
+        );
+        let short = ci_flume(45.0).1;
+        assert!(
+            settled(&case, &short, &[0], &history).is_none(),
+            "ends within a window"
+        );
+    }
+
     /// Of five particles of the CI flume (bed surface 0.055 m, the bed's end 2.23 m): sand in
     /// the top row, a held grain on it, a grain moving in the pit, water over the bed and a
     /// wall past the end. The two grains out of the bed, by x; a grain in the top row, or water
     /// or a wall, listed, or the phase codes read as the case's indices, gives another list.
     #[test]
     fn the_sand_out_of_the_bed_is_listed_by_x() {
-        let flume =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
-        let run = LevelRun {
-            dp_m: 0.01,
-            m3_per_h: 2.0,
-            until_s: 30.0,
-            fixed_bed: false,
-        };
+        let (flume, run) = ci_flume(30.0);
         let (case, channel) = level_case(&flume, &[], &run).expect("the CI flume");
         assert!((channel.bed_m - 0.055).abs() < 1e-9, "{}", channel.bed_m);
         let code = |phase: u32| f32::from_bits(phase);
@@ -656,8 +725,9 @@ mod tests {
             vel_rho: vec![[0.0; 4]; 5],
             ids: (0..5).collect(),
         };
-        // Region 1 held (`REGION_HELD`, 256), region 3 (bed load), water, a wall.
-        let regions = [1 | 256, 3, 1 | 256, 5, 0];
+        // Region 1 held, region 3 (bed load), water, a wall.
+        let held = 1 | flume_solver::physics::sediment::pass::REGION_HELD;
+        let regions = [held, 3, held, 5, 0];
         let loose = loose_sand(&case, &channel, &particles, &regions);
         assert_eq!(loose, vec![(2.163, 0.061, true), (2.305, 0.030, false)]);
     }
@@ -666,14 +736,7 @@ mod tests {
     /// the discharge and the run's length are the benchmark's own.
     #[test]
     fn a_set_reservoir_is_kept() {
-        let flume =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../launch_configs/ulbra_flume.yaml");
-        let run = LevelRun {
-            dp_m: 0.01,
-            m3_per_h: 2.0,
-            until_s: 30.0,
-            fixed_bed: false,
-        };
+        let (flume, run) = ci_flume(30.0);
         let reservoir = |set: &[String]| {
             let (case, _) = level_case(&flume, set, &run).expect("the CI flume");
             assert_eq!(case.numerics.dp_m, 0.01);

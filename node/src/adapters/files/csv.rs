@@ -297,20 +297,8 @@ mod tests {
     /// Observations at `time_s` holding only a profile.
     fn profile_at(time_s: f64, profile: Vec<flume_solver::ProfileColumn>) -> Observations {
         Observations {
-            time_s,
-            steps: 1,
-            dt_s: 1e-4,
-            gauges: vec![],
-            probes: vec![],
             profile,
-            front_m: None,
-            max_speed_m_per_s: 0.0,
-            max_density_error: 0.0,
-            fluid_particles: 0,
-            recoveries: 0,
-            cfl: 0.2,
-            region_counts: None,
-            flume: None,
+            ..crate::test_support::observations_at(time_s)
         }
     }
 
