@@ -244,6 +244,15 @@ struct RegionInputs {
     tau_y: f32,
     c_v: f32,
     picked_up: bool,  // its mass picked up this step; always where Shields releases at once
+    lone: bool,       // no solid beside it at its own level
+}
+
+// Whether a solid neighbour `up` above a sediment particle and `r2` from it squared lies
+// beside it at its level: within half a spacing of its height and one and a half of it
+// (`level_solid` in suspension.rs).
+fn level_solid(up: f32, r2: f32) -> bool {
+    let dp = params.sediment.dp;
+    return up * up < 0.25 * dp * dp && r2 < 2.25 * dp * dp;
 }
 
 // The PCG hash (Jarzynski & Olano 2020), `pcg` in pickup.rs.
@@ -314,8 +323,18 @@ fn exner_pickup(units: i32, id: u32, step: u32, net: f32, dt: f32) -> i32 {
 // Drucker-Prager mode a particle held before stays un-yielded unless Shields makes it bed load
 // (only the hold stage frees it otherwise), any other is bed load, yielded or not, and then
 // suspended below the concentration unless un-yielded. A particle held before that has not been
-// picked up stays held.
+// picked up stays held. Then a grain not held before with no solid beside it at its level
+// is bed load where it would be held: it lies on the bed, not in it.
 fn sediment_region(r: RegionInputs) -> u32 {
+    let region = figure2_region(r);
+    if (region == REGION_UNYIELDED && r.lone && !r.held_before) {
+        return REGION_BED_LOAD;
+    }
+    return region;
+}
+
+// `sediment_region` before the rule for lone grains.
+fn figure2_region(r: RegionInputs) -> u32 {
     if (r.held_before && !r.picked_up) {
         return REGION_UNYIELDED;
     }

@@ -24,7 +24,8 @@ override BEFORE_DT: bool = true;
 // (grad[b] is the column du/dx_b), and for sediment the volumes of sediment and of the
 // mixture, the kernel-weighted sediment mass of the surface test, the bed's normal, and the
 // nearest water particle's distance squared and velocity, relative to i or its own
-// (`sd.water_speed`, `SedimentModel::water_speed` of pass.rs).
+// (`sd.water_speed`, `SedimentModel::water_speed` of pass.rs), and the count of solids beside
+// it at its level.
 struct Gathered {
     grad: mat3x3<f32>,
     sediment_volume: f32,
@@ -33,6 +34,7 @@ struct Gathered {
     normal: vec3<f32>,
     nearest_r2: f32,
     nearest_u: vec3<f32>,
+    level_solids: u32,  // solid neighbours beside it at its own level (`level_solid`)
 }
 
 // Adds neighbour j (sorted order) to the sums of particle i at pos_i moving at vel_i.
@@ -58,6 +60,9 @@ fn gather_neighbour(g: ptr<function, Gathered>, pos_i: vec3<f32>, vel_i: vec3<f3
     // The bed's normal points away from the solid under it: sediment and walls.
     if (phase_j == sd.phase || params.phases[phase_j].mobile < 0.5) {
         (*g).normal -= v_j * gw;
+        if (level_solid(dx[params.vertical_axis], r2)) {
+            (*g).level_solids += 1u;
+        }
     }
     if (phase_j == sd.phase) {
         (*g).sediment_volume += v_j;
@@ -227,7 +232,7 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     }
     let region = sediment_region(RegionInputs(
         sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
-        picked
+        picked, g.level_solids == 0u
     ));
     // What was worn off a particle stays with it while it is held, and only then; under
     // Exner's balance, where it went downstream as bed load, wherever the particle goes.

@@ -82,6 +82,11 @@ fn rheology_matches_the_oracle_drucker_prager_shields() {
 }
 
 #[test]
+fn rheology_lets_a_lone_grain_on_the_bed_move_as_the_oracle_does() {
+    common::lone_grain::check_lone_grain(&CPU, 21);
+}
+
+#[test]
 fn rheology_matches_the_oracle_shields_only() {
     sand_stages::check_rheology(&CPU, sand_stages::shields_only_case(), 22);
 }

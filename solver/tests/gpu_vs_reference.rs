@@ -141,3 +141,8 @@ fn parked_particles_sort_after_every_cell_and_take_no_part() {
 fn inlet_scan_matches_a_scan_of_the_whole_state() {
     on_gpu(parked::check_inlet_scan);
 }
+
+#[test]
+fn rheology_lets_a_lone_grain_on_the_bed_move_as_the_cpu_does() {
+    on_gpu(|b| common::lone_grain::check_lone_grain(b, 21));
+}

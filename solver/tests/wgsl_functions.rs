@@ -219,11 +219,11 @@ fn the_sediment_laws() {
     );
 }
 
-/// Every combination of mode, hold, pick-up, surface, Shields and Drucker-Prager on either side
-/// of their thresholds, and concentrations either side of 0.3.
+/// Every combination of mode, hold, pick-up, a solid beside or none, surface, Shields and
+/// Drucker-Prager on either side of their thresholds, and concentrations either side of 0.3.
 fn region_inputs() -> Vec<RegionInputs> {
     let mut all = Vec::new();
-    for mode in 0..8 {
+    for mode in 0..16 {
         for at_surface in [false, true] {
             for tau_b in [0.5, 1.0, 2.0] {
                 for sqrt_j2 in [0.0, 5.0, 6.0] {
@@ -238,6 +238,7 @@ fn region_inputs() -> Vec<RegionInputs> {
                             tau_y: 5.0,
                             c_v,
                             picked_up: mode & 4 != 0,
+                            lone: mode & 8 != 0,
                         });
                     }
                 }
@@ -256,7 +257,7 @@ fn the_region_and_its_viscosity() {
     let packed: Vec<Input> = inputs
         .iter()
         .map(|r| {
-            let modes = flag(r.shields_only) + 2.0 * flag(r.held_before);
+            let modes = flag(r.shields_only) + 2.0 * flag(r.held_before) + 8.0 * flag(r.lone);
             [
                 [modes, flag(r.picked_up), flag(r.at_surface), r.tau_b],
                 [r.tau_bcr, r.sqrt_j2, r.tau_y, r.c_v],
@@ -266,7 +267,7 @@ fn the_region_and_its_viscosity() {
     let helper = "fn region_probe(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
     let m = u32(a.x);
     let r = RegionInputs((m & 1u) != 0u, (m & 2u) != 0u, a.z > 0.5, a.w, b.x, b.y, b.z, b.w,
-        a.y > 0.5);
+        a.y > 0.5, (m & 8u) != 0u);
     return vec4<f32>(f32(sediment_region(r)), 0.0, 0.0, 0.0);
 }
 ";

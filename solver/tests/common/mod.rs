@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod held_bed;
+pub mod lone_grain;
 pub mod parked;
 pub mod probe;
 pub mod sand_stages;

@@ -76,7 +76,7 @@ pub fn two_steps_of_sand_in_motion(
 /// One round of `check_rheology`: the GPU's rheology, release and force passes from the holds
 /// `held` against the CPU's. Returns the holds after it, how many held particles it released
 /// and the count of each region (walls, 1-5).
-fn check_rheology_round(
+pub fn check_rheology_round(
     sim: &mut flume_solver::Simulation,
     params: &flume_solver::physics::Params,
     model: &flume_solver::physics::sediment::pass::SedimentModel,

@@ -29,7 +29,7 @@ use super::shields::{
     k_gamma, sloped_critical_stress,
 };
 use super::suspension::{
-    Region, RegionInputs, apparent_viscosity, sediment_region, volume_fraction,
+    Region, RegionInputs, apparent_viscosity, level_solid, sediment_region, volume_fraction,
 };
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::phase_index;
@@ -162,6 +162,8 @@ pub struct RheologySums<L: Real = f32> {
     /// relative to this one or its own (`SedimentModel::water_speed`).
     water_r: L,
     water_u: [L; 3],
+    /// Solid neighbours (sediment, walls) beside it at its own level ([`level_solid`]).
+    level_solids: L,
 }
 
 impl<L: Real> Default for RheologySums<L> {
@@ -175,6 +177,7 @@ impl<L: Real> Default for RheologySums<L> {
             normal: [zero; 3],
             water_r: L::splat(f32::INFINITY),
             water_u: [zero; 3],
+            level_solids: zero,
         }
     }
 }
@@ -195,6 +198,7 @@ impl RheologySums<Lanes> {
             out.mixture_volume.0[k] = s.mixture_volume;
             out.kernel_mass.0[k] = s.kernel_mass;
             out.water_r.0[k] = s.water_r;
+            out.level_solids.0[k] = s.level_solids;
         })
     }
 
@@ -209,6 +213,7 @@ impl RheologySums<Lanes> {
             normal: self.normal.map(|n| n.0[k]),
             water_r: self.water_r.0[k],
             water_u: self.water_u.map(|u| u.0[k]),
+            level_solids: self.level_solids.0[k],
         }
     }
 }
@@ -442,6 +447,9 @@ impl<'a> Rheology<'a> {
             for (n, x) in s.normal.iter_mut().zip(x_ij) {
                 *n = L::select(near, *n - c(vol_j) * f * x, *n);
             }
+            let up = x_ij[(self.params.dim - 1) as usize];
+            let beside = near & level_solid(up, r2, self.model.dp_m);
+            s.level_solids = L::select(beside, s.level_solids + c(1.0), s.level_solids);
         }
         if pj != model.sediment_phase && pj != model.water_phase {
             return;
@@ -603,6 +611,7 @@ impl<'a> Rheology<'a> {
             tau_y,
             c_v,
             picked_up,
+            lone: s.level_solids == 0.0,
         });
         let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
         let held = region == Region::Unyielded;

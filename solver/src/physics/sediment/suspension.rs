@@ -10,6 +10,7 @@
 use super::SedimentParams;
 use super::drucker_prager::yields;
 use super::rheology::hbp_viscosity;
+use crate::physics::lanes::Real;
 
 /// Volumetric concentration below which a yielded sediment particle is suspended (Section 2.5.3:
 /// "the threshold for the onset of suspended transport is set to c_v,i < 0.3").
@@ -129,6 +130,17 @@ pub struct RegionInputs {
     /// Whether the particle's mass has been picked up this step ([`super::pickup`]); always
     /// true where Shields releases at once, as the paper does.
     pub picked_up: bool,
+    /// No solid (sediment or wall) lies beside it at its own level ([`level_solid`]).
+    pub lone: bool,
+}
+
+/// Whether a solid neighbour at `x_ij` from a sediment particle (`up` its vertical component,
+/// `r2` its squared length) lies beside it at its own level: within half a particle spacing
+/// `dp` of its height and one and a half spacings of it, the nearest neighbours of a row
+/// and not those of the rows above and below.
+#[inline(always)]
+pub fn level_solid<L: Real>(up: L, r2: L, dp: f32) -> L::Mask {
+    (up * up).lt(L::splat(0.25 * dp * dp)) & r2.lt(L::splat(2.25 * dp * dp))
 }
 
 /// A sediment particle's region as the rheology pass chooses it: [`classify_shields_only`] in
@@ -137,14 +149,17 @@ pub struct RegionInputs {
 /// other is classified by Figure 2 ([`classify`]). In either mode a particle held before that
 /// has not been picked up stays held: Shields' release waits for the pick-up, and so does
 /// suspension (a top row thinned by the pick-ups would otherwise fall below the concentration
-/// of suspension at once, and the water reach the floor through it). The GPU's
+/// of suspension at once, and the water reach the floor through it). In either mode a grain
+/// not held before with no solid beside it at its level (`lone`) is bed load where it would
+/// be held: a rule the paper does not state, whose measure is in the README's levels section.
+/// The GPU's
 /// `sediment_region` in `shaders/common/sediment.wgsl` is compared with it input by input
 /// (`tests/wgsl_functions.rs`).
 pub fn sediment_region(r: &RegionInputs) -> Region {
     if r.held_before && !r.picked_up {
         return Region::Unyielded;
     }
-    if r.shields_only {
+    let region = if r.shields_only {
         classify_shields_only(r.at_surface, r.tau_b, r.tau_bcr, r.c_v)
     } else if r.held_before && !(r.at_surface && r.tau_b > r.tau_bcr) {
         Region::Unyielded
@@ -158,6 +173,14 @@ pub fn sediment_region(r: &RegionInputs) -> Region {
             r.tau_y,
             r.c_v,
         )
+    };
+    // A grain coming to rest with no solid beside it at its own level lies on the bed, not in
+    // it: no skeleton confines it, and at a few particles of depth one such grain held on the
+    // bed's top is a step that dams the flow. It stays bed load until it comes to rest in a row.
+    if region == Region::Unyielded && r.lone && !r.held_before {
+        Region::BedLoad
+    } else {
+        region
     }
 }
 
@@ -334,6 +357,7 @@ mod tests {
             tau_y: 10.0,
             c_v: 0.6,
             picked_up: false,
+            lone: false,
         };
         for shields_only in [true, false] {
             let r = RegionInputs {
@@ -354,5 +378,53 @@ mod tests {
             };
             assert_eq!(sediment_region(&moving), Region::BedLoad, "{moving:?}");
         }
+    }
+
+    /// A grain coming to rest on the bed's top with nothing beside it is not held; one in a
+    /// row is, and so is one the bed held already, lone or not, in either mode.
+    #[test]
+    fn a_lone_grain_coming_to_rest_is_not_held() {
+        for shields_only in [true, false] {
+            let resting = RegionInputs {
+                shields_only,
+                held_before: false,
+                at_surface: true,
+                tau_b: 0.1,
+                tau_bcr: 0.2,
+                sqrt_j2: 1.0,
+                tau_y: 10.0,
+                c_v: 0.6,
+                picked_up: true,
+                lone: false,
+            };
+            assert_eq!(sediment_region(&resting), Region::Unyielded, "{resting:?}");
+            let lone = RegionInputs {
+                lone: true,
+                ..resting
+            };
+            assert_eq!(sediment_region(&lone), Region::BedLoad, "{lone:?}");
+            let held = RegionInputs {
+                held_before: true,
+                ..lone
+            };
+            assert_eq!(sediment_region(&held), Region::Unyielded, "{held:?}");
+            let waiting = RegionInputs {
+                picked_up: false,
+                ..held
+            };
+            assert_eq!(sediment_region(&waiting), Region::Unyielded, "{waiting:?}");
+        }
+    }
+
+    /// The neighbours of a square lattice's row are beside a grain; those of the rows above
+    /// and below, straight or diagonal, are not.
+    #[test]
+    fn the_row_beside_a_grain() {
+        let dp = 0.01;
+        assert!(level_solid(0.0, dp * dp, dp));
+        assert!(level_solid(0.3 * dp, 1.1 * dp * dp, dp));
+        assert!(!level_solid(dp, dp * dp, dp));
+        assert!(!level_solid(dp, 2.0 * dp * dp, dp));
+        assert!(!level_solid(0.0, 4.0 * dp * dp, dp));
     }
 }

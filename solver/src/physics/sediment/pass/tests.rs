@@ -501,3 +501,46 @@ fn a_grain_worn_whole_carries_its_wear_off_the_bed() {
     let alone = wear_for_a_second(&gross, (&pos, &vel), (&words, &none));
     assert_eq!(alone[top(0)].pickup, 0);
 }
+
+/// A grain at rest come down on a flat bed of 13 x 5 held particles (its top at y = 0),
+/// in the Drucker-Prager mode, with `beside` (positions and phases) at its level: whether the
+/// pass holds it.
+fn grain_on_the_bed_is_held(beside: &[([f32; 2], u32)]) -> bool {
+    let (params, model) = flume_case();
+    let model = SedimentModel {
+        shields_only: false,
+        ..model
+    };
+    let at = |x: f32, y: f32, phase: u32| [x, y, 0.0, f32::from_bits(phase)];
+    let rest = |phase: u32| [0.0, 0.0, 0.0, params.phases[phase as usize].rho0];
+    let (mut pos, mut vel, mut held) = (Vec::new(), Vec::new(), Vec::new());
+    for row in 0..5 {
+        for col in -6..=6 {
+            pos.push(at(col as f32 * 0.01, -(row as f32) * 0.01, 2));
+            vel.push(rest(2));
+            held.push(true);
+        }
+    }
+    for &([x, y], phase) in [([0.0, 0.01], 2)].iter().chain(beside) {
+        pos.push(at(x, y, phase));
+        vel.push(rest(phase));
+        held.push(false);
+    }
+    let grain = 65;
+    let out = rheology_pass(&params, &model, &pos, &vel, &held);
+    // The bed stays held whatever lies on it.
+    assert!(out[..grain].iter().all(|r| r.held));
+    out[grain].held
+}
+
+#[test]
+fn a_grain_alone_on_the_bed_is_not_held_and_one_in_a_row_is() {
+    assert!(!grain_on_the_bed_is_held(&[]));
+    // A grain a row higher, or over the next column's gap, is not at its level.
+    assert!(!grain_on_the_bed_is_held(&[([0.0, 0.02], 2)]));
+    assert!(!grain_on_the_bed_is_held(&[([0.015, 0.02], 2)]));
+    assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 2)]));
+    assert!(grain_on_the_bed_is_held(&[([-0.012, 0.013], 2)]));
+    // A wall beside it holds it as a grain would.
+    assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 0)]));
+}
