@@ -14,6 +14,7 @@ if [ "$#" -eq 0 ]; then
     --set 'numerics.boundary={method: generalised}' \
     --set 'numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}' \
     --set phases.1.sediment.erosion=van_rijn_exner \
-    --set phases.1.sediment.shields_speed=water
+    --set phases.1.sediment.shields_speed=water \
+    --set phases.1.sediment.comes_to_rest=beside_a_solid
 fi
 cargo run --release --quiet --bin flume-twin -- "$@"

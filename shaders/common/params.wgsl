@@ -33,7 +33,7 @@ struct Sediment {
     pickup_integrated: u32,  // 1: a held particle leaves once the rate's integral has taken its mass
     exner_step_per_stage: f32, // van Rijn's saltation length per unit T^0.9 over dp (0: no deposition)
     dp: f32,                 // particle spacing, m
-    pad0: u32,
+    rests_beside_solid: u32, // 1: a moving grain is held again only with a solid beside it
 }
 
 // The open flume (2-D); enabled == 0 for a closed tank.

@@ -232,7 +232,7 @@ fn sediment_rheology(i: u32, pos_i: vec3<f32>, rho_i: f32, g: Gathered, ii_d: f3
     }
     let region = sediment_region(RegionInputs(
         sd.shields_only != 0u, held_before, at_surface, tau_b, tau_bcr, sqrt_j2, tau_y, c_v,
-        picked, g.level_solids == 0u
+        picked, sd.rests_beside_solid != 0u && g.level_solids == 0u
     ));
     // What was worn off a particle stays with it while it is held, and only then; under
     // Exner's balance, where it went downstream as bed load, wherever the particle goes.

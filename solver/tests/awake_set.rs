@@ -86,6 +86,7 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
         "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
         "phases.1.sediment.erosion=van_rijn_exner",
         "phases.1.sediment.shields_speed=water",
+        "phases.1.sediment.comes_to_rest=beside_a_solid",
     ]);
     let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5, 6.0]);
     // Not vacuous: walls and grains slept, and the front woke some (fewer slept at the end).
@@ -105,6 +106,7 @@ fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
         "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
         "phases.1.sediment.erosion=van_rijn_integrated",
         "phases.1.sediment.shields_speed=water",
+        "phases.1.sediment.comes_to_rest=beside_a_solid",
         "numerics.integrator={method: symplectic}",
     ]);
     let [first, _] = assert_same_as_full(&case, &[0.5, 2.0]);

@@ -549,6 +549,29 @@ fn the_shields_speed_reaches_both_backends_and_a_wrong_one_is_named() {
     );
 }
 
+#[test]
+fn where_a_grain_comes_to_rest_reaches_both_backends_and_a_wrong_one_is_named() {
+    for (set, want) in [
+        (vec![], 0),
+        (vec!["phases.1.sediment.comes_to_rest=anywhere"], 0),
+        (vec!["phases.1.sediment.comes_to_rest=beside_a_solid"], 1),
+    ] {
+        let (sim, model) = flume_with(&set);
+        assert_eq!(sim.params().sediment.rests_beside_solid, want, "{set:?}");
+        assert_eq!(model.rests_beside_solid, want == 1, "{set:?}");
+    }
+    let (f, r) = refused(&ULBRA.replace(
+        "      criterion: shields_only\n",
+        "      criterion: shields_only\n      comes_to_rest: in_a_row\n",
+    ));
+    assert!(f.starts_with("phases"), "{f}: {r}");
+    assert!(r.contains("unknown variant `in_a_row`"), "{r}");
+    assert!(
+        r.contains("anywhere") && r.contains("beside_a_solid"),
+        "{r}"
+    );
+}
+
 /// The water the pores take is parked, and only an open flume parks: a closed tank's bed with
 /// pores is refused by name, not run without them.
 #[test]

@@ -108,6 +108,8 @@ pub const ULBRA_CI: [&str; 12] = [
     "phases.1.sediment.erosion=van_rijn_exner",
     "--set",
     "phases.1.sediment.shields_speed=water",
+    "--set",
+    "phases.1.sediment.comes_to_rest=beside_a_solid",
 ];
 
 /// `flume-twin run` on the CI-size ULBRA flume from the repository's root (where the bundled

@@ -220,6 +220,9 @@ pub struct SedimentConfig {
     /// The speed the log law of Eqs. 19-21 reads from the nearest water particle.
     #[serde(default)]
     pub shields_speed: ShieldsSpeed,
+    /// Where a moving grain that Figure 2 would hold may come to rest.
+    #[serde(default)]
+    pub comes_to_rest: ComesToRest,
     /// Cap on the apparent viscosity, Pa s. Without it, mu_max = 0.125 h rho_s c0: the
     /// viscosity whose explicit diffusion limit `0.125 h^2 rho / mu` equals the acoustic step
     /// `h / c0`, so the sediment never shortens the time step below what the water needs.
@@ -294,6 +297,20 @@ pub enum ShieldsSpeed {
     RelativeToGrain,
     /// Its own velocity, the flow's over a bed at rest, as `MODEL.md` states Eq. 20's u.
     Water,
+}
+
+/// Where a moving sediment particle that Figure 2 would hold is held again
+/// (`physics::sediment::suspension::sediment_region`).
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ComesToRest {
+    /// Wherever it lies, as the paper's model holds it.
+    #[default]
+    Anywhere,
+    /// Only with a solid (sand or wall) beside it at its own level: a grain alone on the bed's
+    /// top stays bed load, where held it would be a step of one dp, 45 degrees, in a flow a
+    /// few particles deep (the README's sediment section).
+    BesideASolid,
 }
 
 fn default_surface_mass_fraction() -> f64 {

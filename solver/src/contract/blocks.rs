@@ -43,7 +43,7 @@ pub struct SedimentGpu {
     pub pickup_integrated: u32,
     pub exner_step_per_stage: f32,
     pub dp: f32,
-    pub pad: u32,
+    pub rests_beside_solid: u32,
 }
 
 /// `Flume` of `shaders/common/params.wgsl` (units there).

@@ -9,8 +9,8 @@ mod blocks;
 pub use blocks::*;
 
 use crate::config::{
-    BoundaryMethod, Case, DensityDiffusion, Erosion, Integrator, ShieldsSpeed, Viscosity,
-    YieldCriterion,
+    BoundaryMethod, Case, ComesToRest, DensityDiffusion, Erosion, Integrator, ShieldsSpeed,
+    Viscosity, YieldCriterion,
 };
 use crate::derived::{self, Derived};
 use crate::flume::inlet_velocity;
@@ -198,6 +198,7 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
         water_phase: (k_water + 1) as u32,
         shields_only: u32::from(cfg.criterion == YieldCriterion::ShieldsOnly),
         water_speed: u32::from(cfg.shields_speed == ShieldsSpeed::Water),
+        rests_beside_solid: u32::from(cfg.comes_to_rest == ComesToRest::BesideASolid),
         rho_s: rho_s as f32,
         rho_w: rho_w as f32,
         d50: cfg.d50_m as f32,
@@ -247,7 +248,6 @@ fn sediment_params(case: &Case, derived: &Derived) -> SedimentGpu {
             _ => 0.0,
         },
         dp: case.numerics.dp_m as f32,
-        pad: 0,
     }
 }
 
@@ -278,6 +278,7 @@ pub fn sediment_model(case: &Case, derived: &Derived) -> Option<SedimentModel> {
         water_phase: k_water + 1,
         shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
         water_speed: cfg.shields_speed == ShieldsSpeed::Water,
+        rests_beside_solid: block.rests_beside_solid != 0,
         mu_max: block.mu_max,
         pickup_per_s: block.pickup_per_s,
         pickup_integrated: block.pickup_integrated != 0,

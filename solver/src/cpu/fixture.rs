@@ -70,6 +70,7 @@ fn sediment() -> SedimentModel {
         water_phase: WATER as usize,
         shields_only: false,
         water_speed: false,
+        rests_beside_solid: true,
         mu_max: 50.0,
         pickup_per_s: 0.0,
         pickup_integrated: false,

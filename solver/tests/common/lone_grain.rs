@@ -1,5 +1,6 @@
-//! A grain come to rest alone on the bed's top (`sediment_region`'s `lone`): the rheology pass
-//! on any backend against the CPU oracle, where the oracle lets it move rather than hold it.
+//! A grain come to rest alone on the bed's top (`sediment_region`'s `lone`, with
+//! `comes_to_rest: beside_a_solid`): the rheology pass on any backend against the CPU oracle,
+//! where the oracle lets it move rather than hold it.
 
 use super::sand_stages::{check_rheology_round, sediment_in_motion};
 use super::stages::case;
@@ -11,7 +12,10 @@ use flume_solver::physics::sediment::suspension::Region;
 /// its kernel's support at rest: it would be held but for having nothing beside it.
 pub fn check_lone_grain(backend: &Backend, seed: u64) {
     use flume_solver::physics::sediment::pass::rheology_pass;
-    let c = case("tests/cases/sediment_bed_2d.yaml");
+    let mut c = case("tests/cases/sediment_bed_2d.yaml");
+    if let Some(s) = c.phases[1].sediment.as_mut() {
+        s.comes_to_rest = flume_solver::config::ComesToRest::BesideASolid;
+    }
     let dp = c.numerics.dp_m as f32;
     let support = 2.0 * c.numerics.coefh as f32 * 2.0_f32.sqrt() * dp;
     let mut lone = usize::MAX;

@@ -186,6 +186,7 @@ pub fn reference_sediment(
         water_phase: k_water + 1,
         shields_only: cfg.criterion == YieldCriterion::ShieldsOnly,
         water_speed: cfg.shields_speed == flume_solver::config::ShieldsSpeed::Water,
+        rests_beside_solid: cfg.comes_to_rest == flume_solver::config::ComesToRest::BesideASolid,
         mu_max: mu_max as f32,
         pickup_per_s: match cfg.erosion {
             flume_solver::config::Erosion::Threshold => 0.0,

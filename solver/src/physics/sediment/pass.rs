@@ -51,6 +51,9 @@ pub struct SedimentModel {
     /// The Shields test reads the nearest water particle's own velocity, not its velocity
     /// relative to the grain (`config::ShieldsSpeed`).
     pub water_speed: bool,
+    /// A moving grain is held again only with a solid beside it at its own level
+    /// (`config::ComesToRest::BesideASolid`).
+    pub rests_beside_solid: bool,
     /// Largest apparent viscosity, Pa s, of the stress a particle carries. An explicit scheme
     /// is stable for `dt <= 0.125 h^2 rho / mu`; the un-yielded HBP viscosity (tau_y m, tens of
     /// thousands of Pa s for the Louvain bed) would need steps 10^2 to 10^3 times shorter than
@@ -611,7 +614,7 @@ impl<'a> Rheology<'a> {
             tau_y,
             c_v,
             picked_up,
-            lone: s.level_solids == 0.0,
+            lone: model.rests_beside_solid && s.level_solids == 0.0,
         });
         let mu = apparent_viscosity(region, ii_d, tau_y, tau_bcr, c_v, mat);
         let held = region == Region::Unyielded;

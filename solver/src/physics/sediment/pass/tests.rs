@@ -93,6 +93,7 @@ fn flume_case() -> (Params, SedimentModel) {
         water_phase: 1,
         shields_only: true,
         water_speed: false,
+        rests_beside_solid: false,
         mu_max: 50.0,
         pickup_per_s: 0.0,
         pickup_integrated: false,
@@ -503,12 +504,13 @@ fn a_grain_worn_whole_carries_its_wear_off_the_bed() {
 }
 
 /// A grain at rest come down on a flat bed of 13 x 5 held particles (its top at y = 0),
-/// in the Drucker-Prager mode, with `beside` (positions and phases) at its level: whether the
-/// pass holds it.
-fn grain_on_the_bed_is_held(beside: &[([f32; 2], u32)]) -> bool {
+/// in the Drucker-Prager mode, with `beside` (positions and phases) at its level, held again
+/// only beside a solid or `anywhere`: whether the pass holds it.
+fn grain_on_the_bed_is_held(beside: &[([f32; 2], u32)], anywhere: bool) -> bool {
     let (params, model) = flume_case();
     let model = SedimentModel {
         shields_only: false,
+        rests_beside_solid: !anywhere,
         ..model
     };
     let at = |x: f32, y: f32, phase: u32| [x, y, 0.0, f32::from_bits(phase)];
@@ -535,12 +537,14 @@ fn grain_on_the_bed_is_held(beside: &[([f32; 2], u32)]) -> bool {
 
 #[test]
 fn a_grain_alone_on_the_bed_is_not_held_and_one_in_a_row_is() {
-    assert!(!grain_on_the_bed_is_held(&[]));
+    assert!(!grain_on_the_bed_is_held(&[], false));
+    // As the paper's model holds it, anywhere.
+    assert!(grain_on_the_bed_is_held(&[], true));
     // A grain a row higher, or over the next column's gap, is not at its level.
-    assert!(!grain_on_the_bed_is_held(&[([0.0, 0.02], 2)]));
-    assert!(!grain_on_the_bed_is_held(&[([0.015, 0.02], 2)]));
-    assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 2)]));
-    assert!(grain_on_the_bed_is_held(&[([-0.012, 0.013], 2)]));
+    assert!(!grain_on_the_bed_is_held(&[([0.0, 0.02], 2)], false));
+    assert!(!grain_on_the_bed_is_held(&[([0.015, 0.02], 2)], false));
+    assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 2)], false));
+    assert!(grain_on_the_bed_is_held(&[([-0.012, 0.013], 2)], false));
     // A wall beside it holds it as a grain would.
-    assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 0)]));
+    assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 0)], false));
 }
