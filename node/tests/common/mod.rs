@@ -94,8 +94,9 @@ pub fn printed(out: &std::process::Output) -> String {
 /// particles deep, and the paper's choices (DBC walls, alpha = 0.02, the release at once) hold
 /// the water 2-3 cm too high and rising; the twin takes the generalised walls, the flow's eddy
 /// viscosity at 2 m3/h, van Rijn's pick-up worn off the bed net of what settles on it (Exner's
-/// balance) and the Shields test on the water's own speed (README, levels section).
-pub const ULBRA_CI: [&str; 12] = [
+/// balance), the Shields test on the water's own speed, and grains held again only beside a
+/// solid (README, levels and sediment sections).
+pub const ULBRA_CI: [&str; 14] = [
     "--set",
     "numerics.dp_m=0.01",
     "--set",
