@@ -60,7 +60,7 @@ fn gather_neighbour(g: ptr<function, Gathered>, pos_i: vec3<f32>, vel_i: vec3<f3
     // The bed's normal points away from the solid under it: sediment and walls.
     if (phase_j == sd.phase || params.phases[phase_j].mobile < 0.5) {
         (*g).normal -= v_j * gw;
-        if (level_solid(dx[params.vertical_axis], r2)) {
+        if (sd.rests_beside_solid != 0u && level_solid(dx[params.vertical_axis], r2)) {
             (*g).level_solids += 1u;
         }
     }

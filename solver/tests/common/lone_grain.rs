@@ -1,6 +1,5 @@
-//! A grain come to rest alone on the bed's top (`sediment_region`'s `lone`, with
-//! `comes_to_rest: beside_a_solid`): the rheology pass on any backend against the CPU oracle,
-//! where the oracle lets it move rather than hold it.
+//! A grain come to rest alone on the bed's top (`sediment_region`'s `lone`): the rheology pass
+//! on any backend against the CPU oracle, under either `comes_to_rest`.
 
 use super::sand_stages::{check_rheology_round, sediment_in_motion};
 use super::stages::case;
@@ -9,12 +8,34 @@ use flume_solver::physics::sediment::suspension::Region;
 
 /// The sand bed in motion ([`sediment_in_motion`]) with a grain at rest a spacing over the
 /// bed's top near x = 0.1 m, in place of the water particle there, and every particle within
-/// its kernel's support at rest: it would be held but for having nothing beside it.
+/// its kernel's support at rest: held as the paper's model holds it (`anywhere`), bed load
+/// under `beside_a_solid`, having nothing beside it; the backend agreeing with the oracle both
+/// ways (a backend that read the setting wrongly, or not at all, disagrees in one).
 pub fn check_lone_grain(backend: &Backend, seed: u64) {
+    use flume_solver::config::ComesToRest;
+    for (rest, region, held) in [
+        (ComesToRest::Anywhere, Region::Unyielded, true),
+        (ComesToRest::BesideASolid, Region::BedLoad, false),
+    ] {
+        let r = lone_grain_rheology(backend, seed, rest);
+        assert!(
+            r.region == region as u32 && r.held == held,
+            "the lone grain under {rest:?}: {r:?}"
+        );
+    }
+}
+
+/// [`check_lone_grain`]'s scene under `rest`: the oracle's rheology of the grain, after
+/// checking the backend's regions against the oracle's.
+fn lone_grain_rheology(
+    backend: &Backend,
+    seed: u64,
+    rest: flume_solver::config::ComesToRest,
+) -> flume_solver::physics::sediment::pass::ParticleRheology {
     use flume_solver::physics::sediment::pass::rheology_pass;
     let mut c = case("tests/cases/sediment_bed_2d.yaml");
     if let Some(s) = c.phases[1].sediment.as_mut() {
-        s.comes_to_rest = flume_solver::config::ComesToRest::BesideASolid;
+        s.comes_to_rest = rest;
     }
     let dp = c.numerics.dp_m as f32;
     let support = 2.0 * c.numerics.coefh as f32 * 2.0_f32.sqrt() * dp;
@@ -24,20 +45,9 @@ pub fn check_lone_grain(backend: &Backend, seed: u64) {
     });
     let model = super::reference_sediment(&sim);
     let held = vec![false; particles.len()];
-    // The backend's regions agree with the oracle's, the lone grain's among them.
     check_rheology_round(&mut sim, &params, &model, &particles, &held);
-    let pass = rheology_pass(
-        &params,
-        &model,
-        &particles.positions,
-        &particles.vel_rho,
-        &held,
-    );
-    let r = &pass[lone];
-    assert!(
-        r.region == Region::BedLoad as u32 && !r.held,
-        "the lone grain: {r:?}"
-    );
+    let (pos, vel) = (&particles.positions, &particles.vel_rho);
+    rheology_pass(&params, &model, pos, vel, &held)[lone]
 }
 
 /// Turns the water particle nearest the point a spacing over the bed's top near x = 0.1 m

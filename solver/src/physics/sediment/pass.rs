@@ -450,9 +450,12 @@ impl<'a> Rheology<'a> {
             for (n, x) in s.normal.iter_mut().zip(x_ij) {
                 *n = L::select(near, *n - c(vol_j) * f * x, *n);
             }
-            let up = x_ij[(self.params.dim - 1) as usize];
-            let beside = near & level_solid(up, r2, self.model.dp_m);
-            s.level_solids = L::select(beside, s.level_solids + c(1.0), s.level_solids);
+            // Counted only where the count is read: this is the pass's hottest loop.
+            if model.rests_beside_solid {
+                let up = x_ij[(self.params.dim - 1) as usize];
+                let beside = near & level_solid(up, r2, model.dp_m);
+                s.level_solids = L::select(beside, s.level_solids + c(1.0), s.level_solids);
+            }
         }
         if pj != model.sediment_phase && pj != model.water_phase {
             return;

@@ -130,7 +130,8 @@ pub struct RegionInputs {
     /// Whether the particle's mass has been picked up this step ([`super::pickup`]); always
     /// true where Shields releases at once, as the paper does.
     pub picked_up: bool,
-    /// No solid (sediment or wall) lies beside it at its own level ([`level_solid`]).
+    /// No solid (sediment or wall) lies beside it at its own level ([`level_solid`]), and the
+    /// case holds a grain again only beside one (`config::ComesToRest::BesideASolid`).
     pub lone: bool,
 }
 
@@ -150,10 +151,10 @@ pub fn level_solid<L: Real>(up: L, r2: L, dp: f32) -> L::Mask {
 /// has not been picked up stays held: Shields' release waits for the pick-up, and so does
 /// suspension (a top row thinned by the pick-ups would otherwise fall below the concentration
 /// of suspension at once, and the water reach the floor through it). In either mode a grain
-/// not held before with no solid beside it at its level (`lone`) is bed load where it would
-/// be held: a rule the paper does not state, whose measure is in the README's levels section.
-/// The GPU's
-/// `sediment_region` in `shaders/common/sediment.wgsl` is compared with it input by input
+/// not held before with no solid beside it at its level (`lone`, which the rheology pass sets
+/// only under `comes_to_rest: beside_a_solid`) is bed load where it would be held: a rule the
+/// paper does not state, measured in the README's levels section. The GPU's `sediment_region`
+/// in `shaders/common/sediment.wgsl` is compared with it input by input
 /// (`tests/wgsl_functions.rs`).
 pub fn sediment_region(r: &RegionInputs) -> Region {
     if r.held_before && !r.picked_up {
