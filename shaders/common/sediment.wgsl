@@ -167,7 +167,7 @@ fn k_gamma(gamma: f32, phi: f32) -> f32 {
 }
 
 // k_beta k_gamma from the bed's outward normal n and the flow u over it (`slope_factors` in
-// pass.rs): the slope is the normal's tilt along and across the flow's horizontal direction.
+// shields.rs): the slope is the normal's tilt along and across the flow's horizontal direction.
 fn slope_factors(n: vec3<f32>, u: vec3<f32>, phi: f32) -> f32 {
     let v = params.vertical_axis;
     var uh = u;
@@ -177,7 +177,7 @@ fn slope_factors(n: vec3<f32>, u: vec3<f32>, phi: f32) -> f32 {
     if (speed_h == 0.0 || n_len == 0.0) {
         return 1.0;
     }
-    // A bed that faces down holds no grain (`slope_factors` in pass.rs).
+    // A bed that faces down holds no grain (`slope_factors` in shields.rs).
     if (n[v] < 0.0) {
         return 0.0;
     }
@@ -215,7 +215,7 @@ fn hbp_viscosity(ii_d: f32, tau_c: f32) -> f32 {
 }
 
 // Eqs. 29-31, the Drucker-Prager yield stress of a sediment particle of density rho, Pa, from
-// its skeleton pressure p (1 - rho_w / rho_s) (`skeleton_pressure` in pass.rs).
+// its skeleton pressure p (1 - rho_w / rho_s) (`skeleton_pressure` in drucker_prager.rs).
 fn drucker_prager_yield(rho: f32) -> f32 {
     let sd = params.sediment;
     let p_skel = tait_pressure(rho, sd.phase) * (1.0 - sd.rho_w / sd.rho_s);

@@ -41,6 +41,20 @@ pub fn yields(sqrt_j2: f32, tau_y: f32) -> bool {
     sqrt_j2 > tau_y
 }
 
+/// Skeleton pressure p of Eq. 31, Pa, from the sediment particle's pressure `p` (its Tait
+/// pressure, total: grains and pore water).
+///
+/// The paper calls it the skeleton pressure without saying how the pore water pressure is taken
+/// out. Here the pore water carries the fraction `rho_w / rho_s` of the total:
+/// `p_skel = p (1 - rho_w / rho_s)`. At depth d below a bed surface that is itself at the free
+/// surface this is exactly the effective stress `(rho_s - rho_w) g d`; under a water column of
+/// pressure p_top it adds `p_top (1 - rho_w / rho_s)`, making the bed stronger than it is. A
+/// pore pressure carried from the water above would remove that bias at the cost of one more
+/// per-particle state.
+pub fn skeleton_pressure(p: f32, rho_s: f32, rho_w: f32) -> f32 {
+    p * (1.0 - rho_w / rho_s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,5 +99,13 @@ mod tests {
         assert!(!yields(0.5, 1.0));
         // Cohesionless sediment at zero pressure yields under any shear.
         assert!(yields(1e-9, yield_stress(alpha(0.5), 0.0, 0.0)));
+    }
+
+    #[test]
+    fn skeleton_pressure_is_effective_stress_at_the_surface() {
+        // 5 cm below a bed surface that is the free surface: p = rho_s g d = 2710 * 9.81 * 0.05
+        // = 1329.255 Pa; effective stress (rho_s - rho_w) g d = 1710 * 9.81 * 0.05 = 838.755 Pa.
+        let p = skeleton_pressure(1329.255, 2710.0, 1000.0);
+        assert!((p - 838.755).abs() < 1e-2, "{p}");
     }
 }

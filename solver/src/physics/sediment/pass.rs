@@ -18,15 +18,15 @@
 //!   1,767 of the first 6 s' 1,922 pick-ups).
 
 use super::SedimentParams;
-use super::drucker_prager::{alpha, kappa_c, yield_stress};
+use super::drucker_prager::{alpha, kappa_c, skeleton_pressure, yield_stress};
 use super::pickup::{
     EXNER_SPENT, bed_load_flux, exner_exchange, exner_pickup, integrated_pickup, picked_up,
     pickup_rate, units_word, word_units,
 };
 use super::rheology::{Tensor3, hbp_viscosity, second_invariant, sps_viscosity, strain_rate};
 use super::shields::{
-    bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity, k_beta,
-    k_gamma, sloped_critical_stress,
+    bed_shear_stress, critical_bed_shear_stress, critical_shields, friction_velocity,
+    slope_factors, sloped_critical_stress,
 };
 use super::suspension::{
     Region, RegionInputs, apparent_viscosity, level_solid, sediment_region, volume_fraction,
@@ -34,7 +34,7 @@ use super::suspension::{
 use crate::physics::eos::{pressure, tait_b};
 use crate::physics::interaction::phase_index;
 use crate::physics::kernel::Wendland;
-use crate::physics::lanes::{Lanes, Mask, Real, pack};
+use crate::physics::lanes::{Mask, Real};
 use crate::physics::{Params, Viscosity};
 
 /// The sediment model of one run.
@@ -148,148 +148,6 @@ impl ParticleRheology {
     pub fn word(&self) -> u32 {
         self.region | if self.held { REGION_HELD } else { 0 } | units_word(self.pickup)
     }
-}
-
-/// Sums a particle (or [`LANES`](crate::physics::lanes::LANES) of them) gathers from its
-/// neighbours in the rheology pass.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RheologySums<L: Real = f32> {
-    /// `grad[a][b] = sum_j V_j (u_j - u_i)_a (grad_i W_ij)_b` (Eq. 13).
-    grad: [[L; 3]; 3],
-    sediment_volume: L,
-    mixture_volume: L,
-    kernel_mass: L,
-    /// `-sum_solid V_j grad_i W_ij` over sediment and walls: the bed's outward normal.
-    normal: [L; 3],
-    /// Distance to the nearest water particle (infinite: none in reach) and its velocity,
-    /// relative to this one or its own (`SedimentModel::water_speed`).
-    water_r: L,
-    water_u: [L; 3],
-    /// Solid neighbours (sediment, walls) beside it at its own level ([`level_solid`]).
-    level_solids: L,
-}
-
-impl<L: Real> Default for RheologySums<L> {
-    fn default() -> Self {
-        let zero = L::splat(0.0);
-        RheologySums {
-            grad: [[zero; 3]; 3],
-            sediment_volume: zero,
-            mixture_volume: zero,
-            kernel_mass: zero,
-            normal: [zero; 3],
-            water_r: L::splat(f32::INFINITY),
-            water_u: [zero; 3],
-            level_solids: zero,
-        }
-    }
-}
-
-impl RheologySums<Lanes> {
-    /// The sums `sums` side by side ([`pack`]).
-    #[inline(always)]
-    pub fn lanes(sums: &[RheologySums]) -> RheologySums<Lanes> {
-        pack(sums, |out: &mut RheologySums<Lanes>, k, s| {
-            for a in 0..3 {
-                for b in 0..3 {
-                    out.grad[a][b].0[k] = s.grad[a][b];
-                }
-                out.normal[a].0[k] = s.normal[a];
-                out.water_u[a].0[k] = s.water_u[a];
-            }
-            out.sediment_volume.0[k] = s.sediment_volume;
-            out.mixture_volume.0[k] = s.mixture_volume;
-            out.kernel_mass.0[k] = s.kernel_mass;
-            out.water_r.0[k] = s.water_r;
-            out.level_solids.0[k] = s.level_solids;
-        })
-    }
-
-    /// The sums of lane `k`.
-    #[inline(always)]
-    pub fn lane(&self, k: usize) -> RheologySums {
-        RheologySums {
-            grad: self.grad.map(|row| row.map(|g| g.0[k])),
-            sediment_volume: self.sediment_volume.0[k],
-            mixture_volume: self.mixture_volume.0[k],
-            kernel_mass: self.kernel_mass.0[k],
-            normal: self.normal.map(|n| n.0[k]),
-            water_r: self.water_r.0[k],
-            water_u: self.water_u.map(|u| u.0[k]),
-            level_solids: self.level_solids.0[k],
-        }
-    }
-}
-
-/// A particle (or lanes of them) as the rheology pass sees it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RheologySide<L: Real = f32> {
-    pub x: [L; 3],
-    pub v: [L; 3],
-    pub sediment: L::Mask,
-}
-
-impl RheologySide<Lanes> {
-    /// The sides `sides` side by side ([`pack`]).
-    #[inline(always)]
-    pub fn lanes(sides: &[RheologySide]) -> RheologySide<Lanes> {
-        pack(sides, |out: &mut RheologySide<Lanes>, k, s| {
-            for a in 0..3 {
-                out.x[a].0[k] = s.x[a];
-                out.v[a].0[k] = s.v[a];
-            }
-            out.sediment.0[k] = if s.sediment { u32::MAX } else { 0 };
-        })
-    }
-}
-
-/// Skeleton pressure p of Eq. 31, Pa, from the sediment particle's pressure `p` (its Tait
-/// pressure, total: grains and pore water).
-///
-/// The paper calls it the skeleton pressure without saying how the pore water pressure is taken
-/// out. Here the pore water carries the fraction `rho_w / rho_s` of the total:
-/// `p_skel = p (1 - rho_w / rho_s)`. At depth d below a bed surface that is itself at the free
-/// surface this is exactly the effective stress `(rho_s - rho_w) g d`; under a water column of
-/// pressure p_top it adds `p_top (1 - rho_w / rho_s)`, making the bed stronger than it is. A
-/// pore pressure carried from the water above would remove that bias at the cost of one more
-/// per-particle state.
-pub fn skeleton_pressure(p: f32, rho_s: f32, rho_w: f32) -> f32 {
-    p * (1.0 - rho_w / rho_s)
-}
-
-/// `k_beta k_gamma` of Eqs. 22-24 from the bed's outward normal `n` (any length, pointing out of
-/// the bed) and the flow velocity `u` over it, in `dim` dimensions (vertical axis `dim - 1`).
-///
-/// The slope is the normal's tilt: `tan(beta) = n_s / n_v` along the flow's horizontal direction
-/// s, `tan(gamma) = |n_t| / n_v` across it (3-D only). The flow runs down the slope when the
-/// normal leans the way the flow goes (`n_s > 0`). With no horizontal flow, or no normal, the
-/// bed counts as flat (factor 1). A normal pointing down (the roof of a hole the jet dug) holds
-/// no grain, whichever way the water flows: gravity pulls the grain off such a bed, so no
-/// friction holds it (Eq. 22 assumes the grain rests on the bed; for up-slope flow it would
-/// still give a positive factor up to beta = 180 deg - phi).
-pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
-    let v = (dim - 1) as usize;
-    let horizontal = if dim == 2 { 1 } else { 2 };
-    let speed_h: f32 = (0..horizontal).map(|k| u[k] * u[k]).sum::<f32>().sqrt();
-    let n_len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    if speed_h == 0.0 || n_len == 0.0 {
-        return 1.0;
-    }
-    if n[v] < 0.0 {
-        return 0.0;
-    }
-    let mut n_s = 0.0;
-    for k in 0..horizontal {
-        n_s += n[k] * u[k] / speed_h;
-    }
-    let n_t = if dim == 3 {
-        (n[0] * u[1] - n[1] * u[0]) / speed_h
-    } else {
-        0.0
-    };
-    let beta = n_s.abs().atan2(n[v]);
-    let gamma = n_t.abs().atan2(n[v]);
-    k_beta(beta, phi, n_s > 0.0) * k_gamma(gamma, phi)
 }
 
 fn norm3(a: [f32; 3]) -> f32 {
@@ -741,9 +599,11 @@ impl Rheology<'_> {
 
 mod exchange;
 mod oracle;
+mod sums;
 
 pub use exchange::{Exchange, NO_TARGET};
 pub use oracle::{rheology_pass, rheology_pass_drawn, rheology_pass_exner};
+pub use sums::{RheologySide, RheologySums};
 
 #[cfg(test)]
 mod tests;

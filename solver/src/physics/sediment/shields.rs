@@ -473,5 +473,40 @@ pub fn critical_shields_self_consistent(
     Some(state(theta, CRITICAL_SHIELDS_MAX_ITERATIONS, false))
 }
 
+/// `k_beta k_gamma` of Eqs. 22-24 from the bed's outward normal `n` (any length, pointing out of
+/// the bed) and the flow velocity `u` over it, in `dim` dimensions (vertical axis `dim - 1`).
+///
+/// The slope is the normal's tilt: `tan(beta) = n_s / n_v` along the flow's horizontal direction
+/// s, `tan(gamma) = |n_t| / n_v` across it (3-D only). The flow runs down the slope when the
+/// normal leans the way the flow goes (`n_s > 0`). With no horizontal flow, or no normal, the
+/// bed counts as flat (factor 1). A normal pointing down (the roof of a hole the jet dug) holds
+/// no grain, whichever way the water flows: gravity pulls the grain off such a bed, so no
+/// friction holds it (Eq. 22 assumes the grain rests on the bed; for up-slope flow it would
+/// still give a positive factor up to beta = 180 deg - phi).
+pub fn slope_factors(n: [f32; 3], u: [f32; 3], dim: u32, phi: f32) -> f32 {
+    let v = (dim - 1) as usize;
+    let horizontal = if dim == 2 { 1 } else { 2 };
+    let speed_h: f32 = (0..horizontal).map(|k| u[k] * u[k]).sum::<f32>().sqrt();
+    let n_len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if speed_h == 0.0 || n_len == 0.0 {
+        return 1.0;
+    }
+    if n[v] < 0.0 {
+        return 0.0;
+    }
+    let mut n_s = 0.0;
+    for k in 0..horizontal {
+        n_s += n[k] * u[k] / speed_h;
+    }
+    let n_t = if dim == 3 {
+        (n[0] * u[1] - n[1] * u[0]) / speed_h
+    } else {
+        0.0
+    };
+    let beta = n_s.abs().atan2(n[v]);
+    let gamma = n_t.abs().atan2(n[v]);
+    k_beta(beta, phi, n_s > 0.0) * k_gamma(gamma, phi)
+}
+
 #[cfg(test)]
 mod tests;

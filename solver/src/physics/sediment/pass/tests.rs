@@ -1,60 +1,9 @@
-//! The slope factors, the bed's normal and the skeleton pressure, by hand.
+//! The rheology pass by hand: the bed's normal, the Shields chain, the regions and the wear.
 
 use super::*;
 
 use crate::physics::Phase;
 use crate::physics::sediment::pickup::{EXNER_WHOLE, PICKUP_WHOLE, units_word};
-
-const DEG: f32 = std::f32::consts::PI / 180.0;
-
-#[test]
-fn flat_bed_has_unit_slope_factor() {
-    // Normal straight up: beta = gamma = 0, Eqs. 22-23 give sin(phi)/sin(phi) = 1 and
-    // cos(0) sqrt(1 - 0) = 1, whichever way the water flows.
-    for u in [[0.3, 0.0, 0.0], [-0.3, 0.0, 0.0]] {
-        assert_eq!(slope_factors([0.0, 1.0, 0.0], u, 2, 30.0 * DEG), 1.0);
-    }
-    assert_eq!(
-        slope_factors([0.0, 0.0, 2.0], [0.1, 0.2, 0.0], 3, 30.0 * DEG),
-        1.0
-    );
-}
-
-#[test]
-fn slope_factor_by_hand() {
-    // A 2-D bed sloping down towards +x at 10 deg: outward normal (sin 10, cos 10).
-    // Flow towards +x runs down the slope: sin(30 - 10) / sin 30 = 0.342020 / 0.5 = 0.684040.
-    // Flow towards -x runs up it: sin(40) / sin(30) = 0.642788 / 0.5 = 1.285575.
-    let n = [(10.0 * DEG).sin(), (10.0 * DEG).cos(), 0.0];
-    let down = slope_factors(n, [0.2, 0.0, 0.0], 2, 30.0 * DEG);
-    let up = slope_factors(n, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
-    assert!((down - 0.684_040).abs() < 1e-5, "{down}");
-    assert!((up - 1.285_575).abs() < 1e-5, "{up}");
-    // 3-D, the same tilt across a flow along y: gamma = 10 deg, beta = 0;
-    // cos 10 sqrt(1 - tan^2 10 / tan^2 30) = 0.984808 sqrt(1 - 0.031091 / 0.333333)
-    // = 0.984808 sqrt(0.906726) = 0.984808 * 0.952222 = 0.937755.
-    let n3 = [(10.0 * DEG).sin(), 0.0, (10.0 * DEG).cos()];
-    let across = slope_factors(n3, [0.0, 0.2, 0.0], 3, 30.0 * DEG);
-    assert!((across - 0.937_755).abs() < 1e-5, "{across}");
-}
-
-#[test]
-fn a_bed_that_faces_down_holds_no_grain() {
-    // The roof of a hole, its normal 40 deg below the horizontal (beta = 130 deg): a flow
-    // towards -x runs up that slope, where Eq. 22 alone would give sin(160) / sin(30) = 0.684;
-    // towards +x down it, sin(-100) < 0. The grain hangs from the bed: no critical stress.
-    let n = [(40.0 * DEG).cos(), -(40.0 * DEG).sin(), 0.0];
-    for u in [[-0.2, 0.0, 0.0], [0.2, 0.0, 0.0]] {
-        assert_eq!(slope_factors(n, u, 2, 30.0 * DEG), 0.0, "{u:?}");
-    }
-    let n3 = [n[0], 0.0, n[1]];
-    assert_eq!(slope_factors(n3, [-0.2, 0.1, 0.0], 3, 30.0 * DEG), 0.0);
-    // Just above the horizontal, a wall of sand facing the flow still holds (beta = 89 deg:
-    // sin(119) / sin(30) = 1.749).
-    let wall = [(89.0 * DEG).sin(), (89.0 * DEG).cos(), 0.0];
-    let k = slope_factors(wall, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
-    assert!((k - 1.749_2).abs() < 1e-3, "{k}");
-}
 
 /// The case's sand (d50 0.4 mm, 2710 kg/m3, phi 32 deg) in the Shields-only mode, at
 /// dp = 1 cm with h = 1.7 dp: phases wall, water, sand.
@@ -205,14 +154,6 @@ fn a_wall_level_with_the_bed_is_bed() {
     let water = [[-dp, dp], [0.0, dp], [dp, dp]];
     let chain = chain_on_flat_bed(0, &water);
     assert_flat_critical_stress(&chain);
-}
-
-#[test]
-fn skeleton_pressure_is_effective_stress_at_the_surface() {
-    // 5 cm below a bed surface that is the free surface: p = rho_s g d = 2710 * 9.81 * 0.05
-    // = 1329.255 Pa; effective stress (rho_s - rho_w) g d = 1710 * 9.81 * 0.05 = 838.755 Pa.
-    let p = skeleton_pressure(1329.255, 2710.0, 1000.0);
-    assert!((p - 838.755).abs() < 1e-2, "{p}");
 }
 
 /// A flat bed of 13 x 5 held sand particles (x from -6 dp to 6 dp, its top at y = 0) under a

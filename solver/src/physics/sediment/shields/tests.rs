@@ -256,7 +256,7 @@ fn friction_velocity_in_the_gap_at_re_k_70() {
 }
 
 #[test]
-fn slope_factors() {
+fn k_beta_and_k_gamma_by_hand() {
     let phi = 30.0 * DEG;
     assert_eq!(k_beta(0.0, phi, true), 1.0);
     assert_eq!(k_beta(0.0, phi, false), 1.0);
@@ -418,4 +418,53 @@ fn self_consistent_threshold_rejects_floating_grains() {
     assert!(critical_shields_self_consistent(0.0, 2650.0, 1000.0, NU, 9.81).is_none());
     assert!(critical_shields_self_consistent(1e-3, 2650.0, 1000.0, 0.0, 9.81).is_none());
     assert!(critical_shields_self_consistent(1e-3, f32::NAN, 1000.0, NU, 9.81).is_none());
+}
+
+#[test]
+fn flat_bed_has_unit_slope_factor() {
+    // Normal straight up: beta = gamma = 0, Eqs. 22-23 give sin(phi)/sin(phi) = 1 and
+    // cos(0) sqrt(1 - 0) = 1, whichever way the water flows.
+    for u in [[0.3, 0.0, 0.0], [-0.3, 0.0, 0.0]] {
+        assert_eq!(slope_factors([0.0, 1.0, 0.0], u, 2, 30.0 * DEG), 1.0);
+    }
+    assert_eq!(
+        slope_factors([0.0, 0.0, 2.0], [0.1, 0.2, 0.0], 3, 30.0 * DEG),
+        1.0
+    );
+}
+
+#[test]
+fn slope_factor_by_hand() {
+    // A 2-D bed sloping down towards +x at 10 deg: outward normal (sin 10, cos 10).
+    // Flow towards +x runs down the slope: sin(30 - 10) / sin 30 = 0.342020 / 0.5 = 0.684040.
+    // Flow towards -x runs up it: sin(40) / sin(30) = 0.642788 / 0.5 = 1.285575.
+    let n = [(10.0 * DEG).sin(), (10.0 * DEG).cos(), 0.0];
+    let down = slope_factors(n, [0.2, 0.0, 0.0], 2, 30.0 * DEG);
+    let up = slope_factors(n, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
+    assert!((down - 0.684_040).abs() < 1e-5, "{down}");
+    assert!((up - 1.285_575).abs() < 1e-5, "{up}");
+    // 3-D, the same tilt across a flow along y: gamma = 10 deg, beta = 0;
+    // cos 10 sqrt(1 - tan^2 10 / tan^2 30) = 0.984808 sqrt(1 - 0.031091 / 0.333333)
+    // = 0.984808 sqrt(0.906726) = 0.984808 * 0.952222 = 0.937755.
+    let n3 = [(10.0 * DEG).sin(), 0.0, (10.0 * DEG).cos()];
+    let across = slope_factors(n3, [0.0, 0.2, 0.0], 3, 30.0 * DEG);
+    assert!((across - 0.937_755).abs() < 1e-5, "{across}");
+}
+
+#[test]
+fn a_bed_that_faces_down_holds_no_grain() {
+    // The roof of a hole, its normal 40 deg below the horizontal (beta = 130 deg): a flow
+    // towards -x runs up that slope, where Eq. 22 alone would give sin(160) / sin(30) = 0.684;
+    // towards +x down it, sin(-100) < 0. The grain hangs from the bed: no critical stress.
+    let n = [(40.0 * DEG).cos(), -(40.0 * DEG).sin(), 0.0];
+    for u in [[-0.2, 0.0, 0.0], [0.2, 0.0, 0.0]] {
+        assert_eq!(slope_factors(n, u, 2, 30.0 * DEG), 0.0, "{u:?}");
+    }
+    let n3 = [n[0], 0.0, n[1]];
+    assert_eq!(slope_factors(n3, [-0.2, 0.1, 0.0], 3, 30.0 * DEG), 0.0);
+    // Just above the horizontal, a wall of sand facing the flow still holds (beta = 89 deg:
+    // sin(119) / sin(30) = 1.749).
+    let wall = [(89.0 * DEG).sin(), (89.0 * DEG).cos(), 0.0];
+    let k = slope_factors(wall, [-0.2, 0.0, 0.0], 2, 30.0 * DEG);
+    assert!((k - 1.749_2).abs() < 1e-3, "{k}");
 }
