@@ -24,15 +24,17 @@ use flume_solver::Region;
 use flume_solver::physics::eos;
 use flume_solver::physics::eos::pressure;
 use flume_solver::physics::kernel::Wendland;
-use flume_solver::physics::sediment::drucker_prager::skeleton_pressure;
-use flume_solver::physics::sediment::drucker_prager::{alpha, kappa_c, yield_stress};
+use flume_solver::physics::sediment::drucker_prager::{
+    alpha, kappa_c, skeleton_pressure, yield_stress,
+};
 use flume_solver::physics::sediment::pickup::{
     EXNER_SPENT, EXNER_WHOLE, PICKUP_WHOLE, exner_exchange, exner_pickup, integrated_pickup,
     picked_up, pickup_draw, pickup_rate,
 };
 use flume_solver::physics::sediment::rheology::hbp_viscosity;
-use flume_solver::physics::sediment::shields::slope_factors;
-use flume_solver::physics::sediment::shields::{critical_shields, friction_velocity};
+use flume_solver::physics::sediment::shields::{
+    critical_shields, friction_velocity, slope_factors,
+};
 use flume_solver::physics::sediment::suspension::{
     RegionInputs, apparent_viscosity, sediment_region, vand_viscosity,
 };

@@ -42,8 +42,7 @@
 //! dragged by them as by the slow bed of the unheld model. The GPU's
 //! `shaders/stages/hold.wgsl` must give the same regions.
 
-use super::drucker_prager::skeleton_pressure;
-use super::drucker_prager::{alpha, kappa_c, yield_stress, yields};
+use super::drucker_prager::{alpha, kappa_c, skeleton_pressure, yield_stress, yields};
 use super::pass::{ParticleRheology, SedimentModel};
 use super::rheology::{Tensor3, second_invariant};
 use super::suspension::Region;

@@ -18,7 +18,8 @@ pub struct RheologySums<L: Real = f32> {
     /// relative to this one or its own (`SedimentModel::water_speed`).
     pub(super) water_r: L,
     pub(super) water_u: [L; 3],
-    /// Solid neighbours (sediment, walls) beside it at its own level ([`level_solid`](crate::physics::sediment::suspension::level_solid)).
+    /// Solid neighbours (sediment, walls) beside it at its own level
+    /// ([`level_solid`](crate::physics::sediment::suspension::level_solid)).
     pub(super) level_solids: L,
 }
 
