@@ -7,18 +7,19 @@
 //!
 //! The awake set: a wall (or held sand standing as one) takes no acceleration, so its only
 //! output is its density. Under the generalised condition that comes from its wall sums over
-//! the fluid (`physics::boundary`), and its pair sums are not computed. Under DBC its rate
-//! sums the mobile particles alone (`PairModel::add_pair`): with none in the cells within
-//! reach it is exactly zero, and the wall is not visited. A dry wall under the generalised
-//! condition takes rest density without a neighbour loop. Each of these is the value the full
-//! sums give, to the bit (`tests/awake_set.rs`); nothing a mobile particle
+//! the fluid (`physics::boundary`), taken for a group's walls in lanes as the pair sums are
+//! (one test of a wall neighbour spares all eight lanes), and its pair sums are not computed.
+//! Under DBC its rate sums the mobile particles alone (`PairModel::add_pair`): with none in
+//! the cells within reach it is exactly zero, and the wall is not visited. A dry wall under
+//! the generalised condition takes rest density without a neighbour loop. Each of these is
+//! the value the full sums give, to the bit (`tests/awake_set.rs`); nothing a mobile particle
 //! reads is skipped, since every mobile particle runs its own sums.
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
 use crate::physics::boundary::WallSums;
 use crate::physics::interaction::{PairModel, PairSum, Side};
-use crate::physics::lanes::{LANES, Lanes, Real};
+use crate::physics::lanes::{LANES, LaneMask, Lanes, Mask, Real};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
 use rayon::prelude::*;
@@ -135,6 +136,7 @@ impl Pass<'_> {
             let walk = !spared[..range.len()].iter().all(|s| *s);
             let sums = walk.then(|| self.group(&group));
             asleep += if walk { 0 } else { range.len() };
+            let walls = self.wall_sums(&group, &wet);
             for (lane, i) in range.enumerate() {
                 let mut s = PairSum::default();
                 if let Some((sum, tau)) = sums.as_ref().filter(|_| !spared[lane]) {
@@ -143,7 +145,8 @@ impl Pass<'_> {
                         *a += t.0[lane];
                     }
                 }
-                (forces[i - first], dt_limit[i - first]) = self.finish(i, &s, wet[lane]);
+                let wall = walls.as_ref().map(|w| w.lane(lane));
+                (forces[i - first], dt_limit[i - first]) = self.finish(i, &s, wall.as_ref());
             }
             start = group.range.end;
         }
@@ -233,23 +236,48 @@ impl Pass<'_> {
         (sum, tau)
     }
 
-    /// Particle `i`'s forces and step from its sums; a wall that is not `wet` has no mobile
-    /// particle within reach.
-    fn finish(&self, i: usize, sum: &PairSum, wet: bool) -> ([f32; 4], f32) {
+    /// The generalised wall sums (`physics::boundary`) of the walls of `group` that have a
+    /// mobile particle within reach (`wet`), each lane over its own neighbours in sorted
+    /// order, as one wall alone would; None when the group has no such wall. The other lanes'
+    /// sums stay empty: a dry wall takes rest density.
+    #[inline(always)]
+    fn wall_sums(&self, group: &Group, wet: &[bool; LANES]) -> Option<WallSums<Lanes>> {
+        if !self.model.params().generalised_walls {
+            return None;
+        }
+        let range = group.range.clone();
+        let walls = LaneMask::from_fn(|k| {
+            let i = range.start + k;
+            k < range.len() && wet[k] && !self.sides[i].mobile
+        });
+        if !walls.any() {
+            return None;
+        }
+        let side = Side::lanes(&self.sides[range]);
+        let mut sums = WallSums::<Lanes>::default();
+        self.grid.group_cells(
+            group,
+            #[inline(always)]
+            |range, near| {
+                for j in range {
+                    self.model
+                        .add_wall_pair(&side, &self.sides[j], near & walls, &mut sums);
+                }
+            },
+        );
+        Some(sums)
+    }
+
+    /// Particle `i`'s forces and step from its sums, and a wall's density from its `wall`
+    /// sums under the generalised condition (none or empty: dry).
+    fn finish(&self, i: usize, sum: &PairSum, wall: Option<&WallSums>) -> ([f32; 4], f32) {
         let side = &self.sides[i];
         let imposed = self.extra.imposed.get(i).copied().unwrap_or(false);
         let (mut f, mut dt) = self.model.finish(side, sum, !imposed);
         if !side.mobile && self.model.params().generalised_walls {
             // A wall's fourth entry is then its density, not a rate (`physics::boundary`).
-            let mut wall = WallSums::default();
-            if wet {
-                self.grid.rows(self.grid.coords(&side.x), |range| {
-                    for j in range {
-                        self.model.add_wall_pair(side, &self.sides[j], &mut wall);
-                    }
-                });
-            }
-            f[3] = self.model.wall_density(side, &wall);
+            let dry = WallSums::default();
+            f[3] = self.model.wall_density(side, wall.unwrap_or(&dry));
         }
         if let Some((_, _, mu)) = self.extra.stress
             && dt.is_finite()
@@ -284,18 +312,21 @@ mod tests {
             .map(|i| {
                 let mut sum = PairSum::default();
                 let mut tau = [0.0f32; 3];
+                let mut wall = WallSums::default();
                 grid.rows(grid.coords(&sides[i].x), |range| {
                     for j in range {
                         let g = pass.model.add_pair(&sides[i], &sides[j], true, &mut sum);
                         if let (Some(g), Some((div, stress, _))) = (g, pass.extra.stress) {
                             div.add_term(&stress[i], &stress[j], &g, &mut tau);
                         }
+                        pass.model
+                            .add_wall_pair(&sides[i], &sides[j], true, &mut wall);
                     }
                 });
                 for (a, t) in sum.acc.iter_mut().zip(tau) {
                     *a += t;
                 }
-                pass.finish(i, &sum, true)
+                pass.finish(i, &sum, Some(&wall))
             })
             .unzip()
     }

@@ -41,11 +41,11 @@
 //! it pressed on the water in front with no pressure, and that water, driven into the apron
 //! by the buffer behind it, ran through it too (a third of the inflow by 60 s).
 //!
-//! The force pass gathers the sums (`interaction::PairModel::add_pair`) and gives a wall its
-//! density in place of a rate; the integrators store it. A wall's density thus answers to the
-//! fluid of the step before, as the GPU computes it in the same pass.
+//! The force pass gathers the sums (`interaction::PairModel::add_wall_pair`) and gives a wall
+//! its density in place of a rate; the integrators store it. A wall's density thus answers to
+//! the fluid of the step before, as the GPU computes it in the same pass.
 
-use super::lanes::Real;
+use super::lanes::{Lanes, Real};
 
 /// The running sums of one wall particle (or of [`LANES`](super::lanes::LANES) of them):
 /// `sum W`, `sum p W` and `sum rho (x_b - x_f) W` over its fluid neighbours.
@@ -65,6 +65,18 @@ impl<L: Real> WallSums<L> {
         self.p_w = L::select(m, self.p_w + p_f * w, self.p_w);
         for (acc, x) in self.rho_r_w.iter_mut().zip(x_bf) {
             *acc = L::select(m, *acc + rho_f * x * w, *acc);
+        }
+    }
+}
+
+impl WallSums<Lanes> {
+    /// The sums of lane `k`.
+    #[inline(always)]
+    pub fn lane(&self, k: usize) -> WallSums {
+        WallSums {
+            w: self.w.0[k],
+            p_w: self.p_w.0[k],
+            rho_r_w: self.rho_r_w.map(|r| r.0[k]),
         }
     }
 }

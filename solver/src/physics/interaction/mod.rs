@@ -390,22 +390,32 @@ impl<'a> PairModel<'a> {
     }
 
     /// Adds fluid neighbour `j` to the sums of wall `i` under the generalised wall condition
-    /// (`physics::boundary`): nothing for another wall, an imposed-velocity particle, or one
-    /// beyond the support. Scalar and apart from [`PairModel::add_pair`]: only walls need it,
-    /// and its accumulators in the pair loop's lanes cost every particle a third of its speed.
-    #[inline]
-    pub fn add_wall_pair(&self, i: &Side, j: &Side, sums: &mut WallSums) {
-        // Most of a wall's neighbours are walls: they are out before any arithmetic.
+    /// (`physics::boundary`), in the lanes `reach` of `i` (`true` for one wall): nothing for
+    /// another wall, an imposed-velocity particle, or one beyond the support. Apart from
+    /// [`PairModel::add_pair`]: only walls need it, and its accumulators in the pair loop's
+    /// lanes cost every particle a third of its speed.
+    #[inline(always)]
+    pub fn add_wall_pair<L: Real>(
+        &self,
+        i: &Side<L>,
+        j: &Side,
+        reach: L::Mask,
+        sums: &mut WallSums<L>,
+    ) {
+        // Most of a wall's neighbours are walls: they are out before any arithmetic, for all
+        // the lanes at once.
         if !j.mobile || j.imposed {
             return;
         }
-        let x_ij = [i.x[0] - j.x[0], i.x[1] - j.x[1], i.x[2] - j.x[2]];
+        let s = L::splat;
+        let x_ij = [i.x[0] - s(j.x[0]), i.x[1] - s(j.x[1]), i.x[2] - s(j.x[2])];
         let r2 = dot3(x_ij, x_ij);
-        if r2 >= self.support2 || r2 < self.coincident2 {
+        let near = reach & !r2.ge(s(self.support2)) & !r2.lt(s(self.coincident2));
+        if !near.any() {
             return;
         }
         let p_j = j.p_over_rho2 * j.rho * j.rho;
-        sums.add(true, self.kernel.w(r2.sqrt()), p_j, j.rho, x_ij);
+        sums.add(near, self.kernel.w(r2.sqrt()), s(p_j), s(j.rho), x_ij);
     }
 
     /// Wall `i`'s density under the generalised wall condition, from its sums: that of the
@@ -501,7 +511,7 @@ pub fn interact_with_bed_walls(
             // A wall's fourth entry is then its density, not a rate.
             let mut wall = WallSums::default();
             for side_j in &sides {
-                model.add_wall_pair(side_i, side_j, &mut wall);
+                model.add_wall_pair(side_i, side_j, true, &mut wall);
             }
             f[3] = model.wall_density(side_i, &wall);
         }
