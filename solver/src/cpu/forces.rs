@@ -134,7 +134,9 @@ impl Pass<'_> {
             // A group of walls that need no pair sums is not walked at all; in a group
             // with others, their lanes' sums are left unread.
             let walk = !spared[..range.len()].iter().all(|s| *s);
-            let sums = walk.then(|| self.group(&group));
+            // Not `walk.then(|| ..)`: a closure LLVM keeps apart runs without AVX2
+            // (`super::simd`).
+            let sums = if walk { Some(self.group(&group)) } else { None };
             asleep += if walk { 0 } else { range.len() };
             let walls = self.wall_sums(&group, &wet);
             for (lane, i) in range.enumerate() {
