@@ -14,8 +14,9 @@ pub enum Backend {
     /// The wgpu backend on this adapter.
     Gpu(Arc<GpuContext>),
     /// The native CPU backend on this many threads (0: one per core); with `awake_set`,
-    /// walls and held grains far from moving fluid skip their neighbour loops, which gives the
-    /// same bits (`cpu/forces.rs`): false is the full computation it is checked against.
+    /// walls and held grains far from moving fluid or deep under it skip their neighbour loops,
+    /// which gives the same bits (`cpu/forces.rs`, `cpu/multiphase.rs`): false is the full
+    /// computation it is checked against.
     Cpu { threads: usize, awake_set: bool },
 }
 

@@ -1,10 +1,10 @@
 //! The CPU backend's awake set (`cpu/forces.rs`, `cpu/multiphase.rs`): walls, and held grains
-//! far from anything moving, skip their neighbour loops. It must give the full computation's
-//! bits, so each case runs twice, with the awake set and without, while water reaches walls and
-//! held sand that were dry: every particle's position, velocity and density, and every region
-//! word, must agree to the bit. A sleeper that water reached unnoticed (a wall still at rest
-//! density, a grain still held away from the surface) would differ from the step it was
-//! reached.
+//! far from anything moving or deep under the water, skip their neighbour loops. It must give
+//! the full computation's bits, so each case runs twice, with the awake set and without, while
+//! water reaches walls and held sand that were dry: every particle's position, velocity and
+//! density, and every region word, must agree to the bit. A sleeper that water reached
+//! unnoticed (a wall still at rest density, a grain still held away from the surface) would
+//! differ from the step it was reached.
 
 mod common;
 
@@ -78,7 +78,8 @@ fn ulbra(overrides: &[&str]) -> Case {
 /// pick-up worn net of what settles, `van_rijn_exner`): the front crosses 2 m of dry bed in its
 /// first 4 s, waking walls and held sand as it goes, and carries the load it picks up to the
 /// dry bed's top ahead of it, whose grains slept until the water came near; by 6 s it has gone
-/// over the end wall into the pit.
+/// over the end wall into the pit. To 10 s the water covers the bed, and the held grains deep
+/// under it sleep by their last walk (`cpu/multiphase/deep.rs`).
 #[test]
 fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
     let case = ulbra(&[
@@ -88,7 +89,7 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
         "phases.1.sediment.shields_speed=water",
         "phases.1.sediment.comes_to_rest=beside_a_solid",
     ]);
-    let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5, 6.0]);
+    let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5, 6.0, 10.0]);
     // Not vacuous: walls and grains slept, and the front woke some (fewer slept at the end).
     assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
     assert!(

@@ -64,6 +64,7 @@ struct Snapshot {
     regions: Vec<u32>,
     fluxes: Vec<(f32, u32)>,
     bed_tops: Vec<u8>,
+    records: Vec<f32>,
 }
 
 impl State {
@@ -102,12 +103,15 @@ pub struct CpuEngine {
     /// Under `van_rijn_exner`, where each particle's last walk found it on the bed, by id
     /// (`multiphase::Holds::bed_tops`).
     bed_tops: Vec<u8>,
+    /// What each held grain's last walk bounds its kernel mass by, by id (NaN: none;
+    /// `multiphase::Holds::records`).
+    records: Vec<f32>,
     snapshot: Snapshot,
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`.
     seconds: [f64; STAGES.len()],
-    /// Whether walls and held grains far from moving fluid sleep (`forces.rs`,
-    /// `multiphase.rs`); false computes every particle in full, to the same bits.
+    /// Whether walls and held grains far from moving fluid or deep under it sleep
+    /// (`forces.rs`, `multiphase.rs`); false computes every particle in full, to the same bits.
     awake_set: bool,
     /// Particles each neighbour pass of `STAGES` took, and how many of them slept.
     passed: [u64; STAGES.len()],
@@ -144,6 +148,7 @@ impl CpuEngine {
         let regions = vec![0; particles.len()];
         let fluxes = vec![(NO_FLUX, NO_TARGET); particles.len()];
         let bed_tops = vec![multiphase::BED_UNKNOWN; particles.len()];
+        let records = vec![f32::NAN; particles.len()];
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
             pool: Arc::new(pool),
@@ -156,11 +161,13 @@ impl CpuEngine {
                 regions: regions.clone(),
                 fluxes: fluxes.clone(),
                 bed_tops: bed_tops.clone(),
+                records: records.clone(),
             },
             a,
             regions,
             fluxes,
             bed_tops,
+            records,
             probe_points: probe_points.to_vec(),
             seconds: [0.0; STAGES.len()],
             awake_set,
@@ -217,6 +224,7 @@ impl Engine for CpuEngine {
         s.regions.clone_from(&self.regions);
         s.fluxes.clone_from(&self.fluxes);
         s.bed_tops.clone_from(&self.bed_tops);
+        s.records.clone_from(&self.records);
     }
 
     fn restore(&mut self) {
@@ -225,6 +233,7 @@ impl Engine for CpuEngine {
         self.regions.clone_from(&s.regions);
         self.fluxes.clone_from(&s.fluxes);
         self.bed_tops.clone_from(&s.bed_tops);
+        self.records.clone_from(&s.records);
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {
@@ -256,6 +265,10 @@ impl Engine for CpuEngine {
         self.a.positions[slot] = position;
         self.a.vel_rho[slot] = vel_rho;
         self.a.vel_rho_prev[slot] = vel_rho;
+        // A particle placed from outside has taken no walk where it now stands.
+        if let Some(r) = self.records.get_mut(self.a.ids[slot] as usize) {
+            *r = f32::NAN;
+        }
     }
 
     fn inlet_scan(&mut self, spots: &[[f32; 2]], radius: f32) -> Result<InletScan, SolverError> {
@@ -272,6 +285,7 @@ impl Engine for CpuEngine {
         self.regions.copy_from_slice(words);
         // A word set from outside is no walk's: the grain walks before it may sleep.
         self.bed_tops.fill(multiphase::BED_UNKNOWN);
+        self.records.fill(f32::NAN);
     }
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {

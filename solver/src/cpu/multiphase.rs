@@ -20,6 +20,9 @@
 //! own start cannot tell it, but its last walk did ([`Holds::bed_tops`]): its neighbours have
 //! not moved since, for a neighbour that moves is one that stirs. A grain whose last walk is
 //! not known (none yet, or its word set from outside) does not sleep.
+//!
+//! Under the water a held grain deep in the bed sleeps too, where its last walk bounds its
+//! kernel mass over the surface threshold ([`deep`]).
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
@@ -32,7 +35,10 @@ use crate::physics::sediment::pass::{
     SedimentModel,
 };
 use crate::physics::sediment::suspension::Region;
+use deep::{Deep, NO_RECORD};
 use rayon::prelude::*;
+
+mod deep;
 
 /// The held sediment of the last pass and the pick-up draws of this one.
 pub struct Holds<'a> {
@@ -45,12 +51,16 @@ pub struct Holds<'a> {
     /// it passed it to, by id (`van_rijn_exner`; [`NO_FLUX`] for any other).
     pub fluxes: &'a [(f32, u32)],
     pub draws: Option<Draws>,
-    /// Whether held grains far from anything moving sleep (see the module doc); false: every
-    /// grain runs its sums (the full computation the awake set is checked against).
+    /// Whether held grains far from anything moving, or deep under the water, sleep (see the
+    /// module doc); false: every grain runs its sums (the full computation the awake set is
+    /// checked against).
     pub awake_set: bool,
     /// Under `van_rijn_exner`, whether each particle lay at the bed's top when it last walked
     /// its neighbours, by id ([`BED_TOP`], [`BED_BELOW`], or [`BED_UNKNOWN`]); empty otherwise.
     pub bed_tops: &'a [u8],
+    /// What each held grain's last walk bounds its kernel mass by, by id
+    /// ([`RheologyPass::records`]; NaN: none); empty where no grain sleeps under the water.
+    pub records: &'a [f32],
 }
 
 /// A particle's last walk found it at the bed's top ([`Holds::bed_tops`]).
@@ -75,6 +85,9 @@ pub fn bed_top_of(r: &ParticleRheology) -> u8 {
 pub struct RheologyPass {
     pub out: Vec<ParticleRheology>,
     pub asleep: usize,
+    /// Where held grains under the water may sleep ([`deep`]), the record each active particle
+    /// leaves (sorted order; NaN: none), for [`Holds::records`]; empty elsewhere.
+    pub records: Vec<f32>,
 }
 
 /// The rheology of the active particles (sorted order), then, with `release`, the release of
@@ -104,22 +117,41 @@ pub fn rheology_pass(
         let id = holds.ids[i] as usize;
         !exner || (holds.bed_tops[id] != BED_UNKNOWN && named.as_ref().is_some_and(|n| !n[id]))
     };
+    let deep = stirrers
+        .as_ref()
+        .and_then(|_| Deep::new(params, model, &pass, (pos, vel), holds.words));
+    let record_of = |i: usize| {
+        let id = holds.ids[i] as usize;
+        holds.records.get(id).copied().unwrap_or(NO_RECORD)
+    };
+    // Whether a held grain sleeps, and whether its walk, if it takes one, leaves a record
+    // ([`deep`]): a dry grain sleeps, and under the water a quiet one whose record allows.
+    let state = |i: usize, x: &[f32; 3]| {
+        if !held_before(i) {
+            return (false, false);
+        }
+        let dry = stirrers.as_ref().is_some_and(|s| !grid.any_near(s, x));
+        if dry {
+            return (may_sleep(i), deep.is_some());
+        }
+        let quiet = deep.as_ref().is_some_and(|d| d.quiet(grid, x));
+        let deep_asleep = quiet && deep.as_ref().is_some_and(|d| d.sleeps(record_of(i)));
+        (deep_asleep && may_sleep(i), quiet)
+    };
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
-    let (vol, (sides, asleep)): (Vec<f32>, (Vec<RheologySide>, Vec<bool>)) = pool.install(|| {
-        (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let side = pass.side(&pos[i], &vel[i]);
-                let sleeps = held_before(i)
-                    && stirrers
-                        .as_ref()
-                        .is_some_and(|s| !grid.any_near(s, &side.x))
-                    && may_sleep(i);
-                (pass.volume(&pos[i], &vel[i]), (side, sleeps))
-            })
-            .unzip()
-    });
+    type Sleep = (Vec<bool>, Vec<bool>);
+    let (vol, (sides, (asleep, recordable))): (Vec<f32>, (Vec<RheologySide>, Sleep)) = pool
+        .install(|| {
+            (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let side = pass.side(&pos[i], &vel[i]);
+                    let state = state(i, &side.x);
+                    (pass.volume(&pos[i], &vel[i]), (side, state))
+                })
+                .unzip()
+        });
     let pairs = Pairs {
         params,
         pass: &pass,
@@ -134,6 +166,9 @@ pub fn rheology_pass(
         asleep: &asleep,
         bed_tops: exner.then_some(holds.bed_tops),
         named: named.as_deref(),
+        deep: deep.as_ref(),
+        recordable: &recordable,
+        records: holds.records,
     };
     // Every slot is written by its block.
     let none = ParticleRheology {
@@ -146,13 +181,15 @@ pub fn rheology_pass(
         target: NO_TARGET,
     };
     let mut out = vec![none; n];
+    let mut records = vec![NO_RECORD; n];
     let asleep = pool.install(|| {
         out.par_chunks_mut(BLOCK)
+            .zip(records.par_chunks_mut(BLOCK))
             .enumerate()
-            .map(|(b, out)| {
+            .map(|(b, (out, records))| {
                 simd::dispatch(
                     #[inline(always)]
-                    || pairs.block(b * BLOCK, out),
+                    || pairs.block(b * BLOCK, out, records),
                 )
             })
             .sum()
@@ -160,7 +197,14 @@ pub fn rheology_pass(
     if release {
         release_held(pool, (params, model), grid, (pos, vel), &mut out);
     }
-    RheologyPass { out, asleep }
+    if deep.is_none() {
+        records.clear();
+    }
+    RheologyPass {
+        out,
+        asleep,
+        records,
+    }
 }
 
 /// Releases the held sediment whose neighbours transmit enough stress (`hold.wgsl`), from the
@@ -246,14 +290,20 @@ struct Pairs<'a> {
     bed_tops: Option<&'a [u8]>,
     /// Under `van_rijn_exner`, whether the last pass that drew named each particle, by id.
     named: Option<&'a [bool]>,
+    /// Where held grains under the water may sleep: the rule, whether each particle's walk
+    /// leaves a record, and the records of the last walks by id ([`deep`]).
+    deep: Option<&'a Deep>,
+    recordable: &'a [bool],
+    records: &'a [f32],
 }
 
 impl Pairs<'_> {
     /// The rheology of the particles from `first` into `out`, in groups of one row of cells
     /// as the force pass takes them: each lane sums its own neighbours in sorted order.
-    /// Returns how many were spared the walk over their neighbours.
+    /// Returns how many were spared the walk over their neighbours. With [`deep`]'s rule each
+    /// particle's record goes to `records`: a sleeper keeps its own.
     #[inline(always)]
-    fn block(&self, first: usize, out: &mut [ParticleRheology]) -> usize {
+    fn block(&self, first: usize, out: &mut [ParticleRheology], records: &mut [f32]) -> usize {
         let mut asleep = 0;
         let (pass, grid, pos, vel) = (self.pass, self.grid, self.pos, self.vel);
         let end = first + out.len();
@@ -268,6 +318,8 @@ impl Pairs<'_> {
             if group.range.clone().all(spared) {
                 asleep += group.range.len();
                 for i in group.range.clone() {
+                    let id = self.ids[i] as usize;
+                    records[i - first] = self.records.get(id).copied().unwrap_or(NO_RECORD);
                     let s = pass.start(&pos[i], &vel[i]);
                     let before = (self.words[i], self.ids[i]);
                     let r = &mut out[i - first];
@@ -283,6 +335,9 @@ impl Pairs<'_> {
                 let sums = self.group(&group);
                 for (lane, i) in group.range.clone().enumerate() {
                     let s = sums.lane(lane);
+                    if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
+                        records[i - first] = d.record(s.kernel_mass());
+                    }
                     let exchange = self.exchange(i, &s);
                     let before = (self.words[i], self.ids[i]);
                     out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, exchange);
@@ -347,177 +402,4 @@ impl Pairs<'_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cpu::fixture::{Fixture, SAND, fixture};
-    use crate::physics::Viscosity;
-
-    fn two_threads() -> rayon::ThreadPool {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .expect("a pool of two threads")
-    }
-
-    /// Particle `i`'s sums as it walks its neighbours alone over `Grid::rows`, each pair by
-    /// the f32 formulas.
-    fn own_sums(fx: &Fixture, pass: &Rheology, i: usize) -> RheologySums {
-        let (x, v) = (&fx.pos[i], &fx.vel[i]);
-        let mut s = pass.start(x, v);
-        if fx.params.phases[phase_index(x)].mobile {
-            let side = pass.side(x, v);
-            fx.grid.rows(fx.grid.coords(&side.x), |range| {
-                for j in range {
-                    let vol = pass.volume(&fx.pos[j], &fx.vel[j]);
-                    let j = (&fx.pos[j], &fx.vel[j]);
-                    pass.add_pair_of_volume(&side, j, vol, true, &mut s);
-                }
-            });
-        }
-        s
-    }
-
-    #[test]
-    fn each_lane_gets_the_rheology_of_its_particle_alone() {
-        let fx = fixture(Viscosity::Multiphase {
-            alpha: 0.05,
-            sps_length2: 0.0,
-        });
-        let pool = two_threads();
-        let n = fx.pos.len();
-        let held: Vec<u32> = (0..n)
-            .map(|i| if i % 3 == 0 { REGION_HELD } else { 0 })
-            .collect();
-        let ids: Vec<u32> = (0..n as u32).collect();
-        let fluxes = vec![(NO_FLUX, NO_TARGET); n];
-        let (params, grid) = (&fx.params, &fx.grid);
-        let pass_with = |awake_set| {
-            let holds = Holds {
-                words: &held,
-                ids: &ids,
-                fluxes: &fluxes,
-                draws: None,
-                awake_set,
-                bed_tops: &[],
-            };
-            let (pos, vel) = (&fx.pos, &fx.vel);
-            rheology_pass(&pool, params, &fx.sediment, grid, pos, vel, &holds, false).out
-        };
-        let pass = Rheology::new(params, &fx.sediment);
-        let want: Vec<ParticleRheology> = (0..n)
-            .map(|i| {
-                let s = own_sums(&fx, &pass, i);
-                let (x, v) = (&fx.pos[i], &fx.vel[i]);
-                pass.finish(x, v, &s, (held[i], ids[i]), NONE_PASSED)
-            })
-            .collect();
-        let word_bits = |r: &[ParticleRheology]| -> Vec<(u32, u32, Vec<u32>)> {
-            r.iter()
-                .map(|p| {
-                    let stress = p.stress.iter().flatten().map(|s| s.to_bits());
-                    (p.word(), p.mu.to_bits(), stress.collect())
-                })
-                .collect()
-        };
-        for awake_set in [false, true] {
-            assert!(word_bits(&pass_with(awake_set)) == word_bits(&want));
-        }
-        // Not a vacuous comparison: the bed's top layer sees the water and yields or moves.
-        let sand = (0..n).filter(|&i| fx.pos[i][3].to_bits() == SAND);
-        let regions: std::collections::BTreeSet<u32> = sand.map(|i| want[i].region).collect();
-        assert!(regions.len() > 1, "{regions:?}");
-    }
-
-    /// Under `van_rijn_exner`, in a pass that draws, every sediment particle takes the load
-    /// the last pass named to it, whether or not it names one itself: on the fixture's held
-    /// bed, each grain of the bottom row (under no water, so it names none) is named by the
-    /// grain above it, and the top row names targets of its own under the moving water. The
-    /// lanes' pass, with the awake set and without, gives each particle's word, flux and target
-    /// as it walks its neighbours alone, its exchange over the same cells.
-    #[test]
-    fn under_exner_a_grain_that_names_none_still_takes_what_was_named_to_it() {
-        use crate::physics::sediment::pickup::word_units;
-        let fx = fixture(Viscosity::Multiphase {
-            alpha: 0.05,
-            sps_length2: 0.0,
-        });
-        let model = fx.sediment.clone().worn_by_van_rijn(true);
-        let pool = two_threads();
-        let n = fx.pos.len();
-        let sand = |i: usize| fx.pos[i][3].to_bits() == SAND;
-        let words: Vec<u32> = (0..n)
-            .map(|i| if sand(i) { REGION_HELD } else { 0 })
-            .collect();
-        let ids: Vec<u32> = (0..n as u32).collect();
-        // The bottom row lies within 0.2 dp of y = 1.5 dp, the row above within 0.2 dp of 2.5.
-        let row = |i: usize, y: f32| sand(i) && (fx.pos[i][1] - y).abs() < 0.0025;
-        let mut fluxes = vec![(NO_FLUX, NO_TARGET); n];
-        let mut named = Vec::new();
-        for d in (0..n).filter(|&d| row(d, 0.015)) {
-            let above = (0..n)
-                .filter(|&k| row(k, 0.025) && fluxes[k].1 == NO_TARGET)
-                .min_by(|&a, &b| {
-                    let dx = |k: usize| (fx.pos[k][0] - fx.pos[d][0]).abs();
-                    dx(a).total_cmp(&dx(b))
-                })
-                .expect("a grain above");
-            fluxes[above] = (0.5, d as u32);
-            named.push(d);
-        }
-        let draws = Some(Draws {
-            step: 3,
-            dt_s: 1.0e-4,
-        });
-        let (params, grid) = (&fx.params, &fx.grid);
-        let pass = Rheology::new(params, &model).with_draws(draws);
-        let want: Vec<ParticleRheology> = (0..n)
-            .map(|i| {
-                let s = own_sums(&fx, &pass, i);
-                let (x, v) = (&fx.pos[i], &fx.vel[i]);
-                let exchange =
-                    pass.exchange_of((x, ids[i]), &s, words[i])
-                        .map_or(NONE_PASSED, |mut ex| {
-                            grid.rows(grid.coords(&[x[0], x[1], x[2]]), |range| {
-                                for j in range {
-                                    ex.add(&fx.pos[j], ids[j], fluxes[j]);
-                                }
-                            });
-                            ex.outcome()
-                        });
-                pass.finish(x, v, &s, (words[i], ids[i]), exchange)
-            })
-            .collect();
-        let bed_tops = vec![BED_UNKNOWN; n];
-        let outcome = |r: &[ParticleRheology]| -> Vec<(u32, u32, u32)> {
-            r.iter()
-                .map(|p| (p.word(), p.flux.to_bits(), p.target))
-                .collect()
-        };
-        for awake_set in [false, true] {
-            let holds = Holds {
-                words: &words,
-                ids: &ids,
-                fluxes: &fluxes,
-                draws,
-                awake_set,
-                bed_tops: &bed_tops,
-            };
-            let (pos, vel) = (&fx.pos, &fx.vel);
-            let got = rheology_pass(&pool, params, &model, grid, pos, vel, &holds, false).out;
-            assert!(outcome(&got) == outcome(&want), "awake set {awake_set}");
-        }
-        // Not vacuous: the load settled on every named grain of the bottom row, and the top
-        // row named targets of its own.
-        for &d in &named {
-            assert!(
-                word_units(want[d].word(), true) < 0,
-                "grain {d}: {:?}",
-                want[d]
-            );
-        }
-        assert!(
-            want.iter().any(|r| r.target != NO_TARGET),
-            "none named a target"
-        );
-    }
-}
+mod tests;

@@ -151,6 +151,7 @@ impl CpuEngine {
             draws,
             awake_set: self.awake_set,
             bed_tops: &self.bed_tops,
+            records: &self.records,
         };
         let release = self.shape.hold;
         let (params, pool) = (&self.model, &self.pool);
@@ -171,6 +172,15 @@ impl CpuEngine {
             }
             for &id in &b.ids[active..] {
                 self.bed_tops[id as usize] = BED_UNKNOWN;
+            }
+        }
+        // A held grain under the water sleeps by its last walk's record (`multiphase::deep`).
+        if !pass.records.is_empty() {
+            for (&r, &id) in pass.records.iter().zip(&b.ids) {
+                self.records[id as usize] = r;
+            }
+            for &id in &b.ids[active..] {
+                self.records[id as usize] = f32::NAN;
             }
         }
         if draws.is_some() && exner {

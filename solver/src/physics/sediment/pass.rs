@@ -219,6 +219,12 @@ impl<'a> Rheology<'a> {
         }
     }
 
+    /// Kernel mass below which a sediment particle with water in reach is at the bed's
+    /// surface (Eq. 26), kg.
+    pub fn reference_mass(&self) -> f32 {
+        self.reference_mass
+    }
+
     /// The pass with the pick-up draws `draws`.
     pub fn with_draws(self, draws: Option<Draws>) -> Rheology<'a> {
         Rheology { draws, ..self }

@@ -39,6 +39,13 @@ impl<L: Real> Default for RheologySums<L> {
     }
 }
 
+impl RheologySums {
+    /// The kernel mass of sediment around the particle, kg (Eq. 26's, with its own).
+    pub fn kernel_mass(&self) -> f32 {
+        self.kernel_mass
+    }
+}
+
 impl RheologySums<Lanes> {
     /// The sums `sums` side by side ([`pack`]).
     #[inline(always)]
