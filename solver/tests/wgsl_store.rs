@@ -232,3 +232,28 @@ fn sand_in_the_inlet_buffer_leaves_with_the_inflow() {
     let ((pos, vel), _) = store.apply(7, &below, &rest, true, DT, (below, rest));
     assert_eq!((pos, vel[..3].to_vec()), (below, vec![0.0; 3]));
 }
+
+/// A held grain the store parks (here in the collector) says so: its mass leaves the kernels
+/// of the grains around it, whose records of it must go (`cpu/multiphase/deep.rs`). A moving
+/// grain parked there, or a held one kept, does not.
+#[test]
+fn a_held_grain_parked_says_so() {
+    let mut flume = case("../launch_configs/ulbra_flume.yaml", 0.01);
+    if let Some(f) = &mut flume.open_flume {
+        f.reservoir_particles = 2500;
+    }
+    let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &flume).expect("runs");
+    let (uniform, params) = (*sim.params(), common::reference_params(&sim));
+    let store = Store::new(&uniform, &params);
+    let f = &uniform.flume;
+    let sand = uniform.sediment.phase;
+    let rest = [0.0, 0.0, 0.0, params.phases[sand as usize].rho0];
+    let x = 0.5 * (f.collector_x_min + f.collector_x_max);
+    let pit = [x, 0.5 * f.collector_y_max, 0.0, f32::from_bits(sand)];
+    let bed = [1.0, 0.03, 0.0, pit[3]];
+    let parked = |at: &[f32; 4], held| store.apply(7, at, &rest, held, DT, (*at, rest)).1;
+    let (held, moving, kept) = (parked(&pit, true), parked(&pit, false), parked(&bed, true));
+    assert!(held.parked && held.held_parked, "{held:?}");
+    assert!(moving.parked && !moving.held_parked, "{moving:?}");
+    assert!(!kept.parked && !kept.held_parked, "{kept:?}");
+}

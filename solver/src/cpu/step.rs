@@ -235,7 +235,7 @@ impl CpuEngine {
         let holds = self.holds(&b);
         let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
-        let next = Self::store_all(&self.pool, st, buffers, |i| {
+        let (next, held_parked) = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
             let Some(f) = forces.get(i) else {
                 // Parked: out of the flow.
@@ -254,6 +254,7 @@ impl CpuEngine {
             (out, prev, event)
         });
         self.a = State { ids: b.ids, ..next };
+        self.forget_records(held_parked);
     }
 
     fn symplectic(&mut self, st: &mut StepState, grid: &Grid, b: State, forces: &[[f32; 4]]) {
@@ -288,7 +289,7 @@ impl CpuEngine {
         let holds = self.holds(&b);
         let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
-        let next = Self::store_all(&self.pool, st, buffers, |i| {
+        let (next, held_parked) = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
             let Some(f) = forces_half.get(i) else {
                 return ((*x, *v), b.vel_rho_prev[i], Event::default());
@@ -302,6 +303,7 @@ impl CpuEngine {
             (out, b.vel_rho_prev[i], event)
         });
         self.a = State { ids: b.ids, ..next };
+        self.forget_records(held_parked);
         self.timed(STAGE_INTEGRATE, start);
     }
 
@@ -316,13 +318,14 @@ impl CpuEngine {
     /// Stores each particle (`store_one(i)`: where it goes, its velocity of the step
     /// before and what storing it did), in parallel, straight into the state that follows
     /// (the buffers of the state before, whose sorted copy the step read); the events, rare,
-    /// are tallied in sorted order. The state's ids are left to the caller.
+    /// are tallied in sorted order. The state's ids are left to the caller. Returns it, and
+    /// whether a held grain was parked.
     fn store_all(
         pool: &rayon::ThreadPool,
         st: &mut StepState,
         mut next: State,
         store_one: impl Fn(usize) -> (Particle, [f32; 4], Event) + Sync,
-    ) -> State {
+    ) -> (State, bool) {
         let events: Vec<Event> = pool.install(|| {
             let out = next.positions.par_iter_mut().zip(&mut next.vel_rho);
             out.zip(&mut next.vel_rho_prev)
@@ -335,7 +338,15 @@ impl CpuEngine {
                 .collect()
         });
         tally(st, &events);
-        next
+        (next, events.iter().any(|e| e.held_parked))
+    }
+
+    /// After a held grain was parked, no record bounds a kernel mass it was in
+    /// (`multiphase::deep`).
+    fn forget_records(&mut self, held_parked: bool) {
+        if held_parked {
+            self.records.fill(f32::NAN);
+        }
     }
 }
 

@@ -17,6 +17,9 @@ pub struct Event {
     pub eroded: bool,
     pub excluded: Option<ExcludedParticle>,
     pub excluded_sediment: bool,
+    /// A held grain was parked: its mass left its neighbours' kernels while they slept
+    /// (`multiphase::deep`).
+    pub held_parked: bool,
 }
 
 impl Event {
@@ -143,9 +146,10 @@ impl<'a> Store<'a> {
         let phase = self.phase(p);
         let (x, v) = moved;
         if let (Some(f), true) = (self.flume, phase.mobile)
-            && let Some(stored) = self.flume_zones(f, id, (p, vr), dt, (x, v))
+            && let Some((stored, mut event)) = self.flume_zones(f, id, (p, vr), dt, (x, v))
         {
-            return stored;
+            event.held_parked = held && event.parked;
+            return (stored, event);
         }
         if !phase.mobile {
             // Walls keep position and velocity and rho >= rho0 (the integrator saw to it);

@@ -12,14 +12,15 @@
 //!
 //! The bound. Let the last walk find kernel mass `m_k = sum_j c_j / rho_j` over the sediment
 //! j within 2h, `c_j = m_j^2 W_ij`, with no sediment in the cells within reach but held grains
-//! at rest, and `i` itself held. Held grains at rest do not move, and the store never parks
-//! one; sediment that arrives since only adds to the sum, and sediment that leaves must first
-//! move, which wakes the grain while it is within reach. So every `c_j` of that walk is still
-//! there, and `m_now >= sum_j c_j / rho_max >= m_k rho_min / rho_max`, with `rho_min` the held
-//! grains' least density at that walk and `rho_max` their largest now. The record a walk
-//! leaves is `m_k rho_min / rho0`; the grain sleeps while `record rho0 / rho_max` is over the
-//! threshold by [`SLACK`], which covers the sums' rounding in f32. Any other walk clears the
-//! record, and so does a word set from outside or a grain parked.
+//! at rest, and `i` itself held. Held grains at rest do not move, and a held grain the store
+//! parks (one in a flume's collector or past its outlet) clears every record; sediment that
+//! arrives since only adds to the sum, and sediment that leaves must first move, which wakes
+//! the grain while it is within reach. So every `c_j` of that walk is still there, and
+//! `m_now >= sum_j c_j / rho_max >= m_k rho_min / rho_max`, with `rho_min` the held grains'
+//! least density at that walk and `rho_max` their largest now. The record a walk leaves is
+//! `m_k rho_min / rho0`; the grain sleeps while `record rho0 / rho_max` is over the threshold
+//! by [`SLACK`], which covers the sums' rounding in f32. Any other walk clears the record, and
+//! so does a word set from outside, or the grain parked or placed.
 
 use super::super::grid::{Flagged, Grid};
 use crate::physics::Params;
