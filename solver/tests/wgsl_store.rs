@@ -15,7 +15,9 @@ mod common;
 
 use common::gpu_lock;
 use common::probe::{Input, Probe, probe_of, same};
+use flume_solver::contract::SimParams;
 use flume_solver::gpu::shader;
+use flume_solver::physics::Params;
 use flume_solver::{Case, Store};
 
 /// The step of every probe, s.
@@ -193,6 +195,16 @@ fn the_store_rule_at_a_bottom_outlet() {
     agree_on(&probe, &[KEPT, PARKED, EXCLUDED]);
 }
 
+/// The CI-size flume's uniform block and physics, as the CPU backend stores with them.
+fn ci_flume() -> (SimParams, Params) {
+    let mut flume = case("../launch_configs/ulbra_flume.yaml", 0.01);
+    if let Some(f) = &mut flume.open_flume {
+        f.reservoir_particles = 2500;
+    }
+    let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &flume).expect("runs");
+    (*sim.params(), common::reference_params(&sim))
+}
+
 /// A grain that strays into the inlet's opening leaves with the inflow, held or not, in the
 /// predictor's half step and in the store (the CPU side; `agree_on` holds the WGSL's store to
 /// it). On the paper's bed, sand to the orifice, two grains the jet lifted came to rest held in
@@ -201,12 +213,7 @@ fn the_store_rule_at_a_bottom_outlet() {
 /// (docs/scour/README.md).
 #[test]
 fn sand_in_the_inlet_buffer_leaves_with_the_inflow() {
-    let mut flume = case("../launch_configs/ulbra_flume.yaml", 0.01);
-    if let Some(f) = &mut flume.open_flume {
-        f.reservoir_particles = 2500;
-    }
-    let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &flume).expect("runs");
-    let (uniform, params) = (*sim.params(), common::reference_params(&sim));
+    let (uniform, params) = ci_flume();
     let store = Store::new(&uniform, &params);
     let f = &uniform.flume;
     let sand = uniform.sediment.phase;
@@ -238,12 +245,7 @@ fn sand_in_the_inlet_buffer_leaves_with_the_inflow() {
 /// grain parked there, or a held one kept, does not.
 #[test]
 fn a_held_grain_parked_says_so() {
-    let mut flume = case("../launch_configs/ulbra_flume.yaml", 0.01);
-    if let Some(f) = &mut flume.open_flume {
-        f.reservoir_particles = 2500;
-    }
-    let sim = flume_solver::Simulation::new(flume_solver::Backend::cpu(1), &flume).expect("runs");
-    let (uniform, params) = (*sim.params(), common::reference_params(&sim));
+    let (uniform, params) = ci_flume();
     let store = Store::new(&uniform, &params);
     let f = &uniform.flume;
     let sand = uniform.sediment.phase;
