@@ -155,6 +155,24 @@ impl Grid {
 }
 
 impl Grid {
+    /// Calls `visit` with the sorted-index range of each row of cells that holds a part of
+    /// the box from `lo` to `hi`, in the order of [`Grid::rows`]: every particle in the box
+    /// is in one of them.
+    #[inline]
+    pub fn rows_in_box(&self, lo: &[f32; 3], hi: &[f32; 3], mut visit: impl FnMut(Range<usize>)) {
+        let (a, b) = (self.coords(lo), self.coords(hi));
+        for z in a[2]..=b[2] {
+            for y in a[1]..=b[1] {
+                let base = self.index([0, y, z]);
+                let lo = self.starts[base + a[0] as usize] as usize;
+                let hi = self.starts[base + b[0] as usize + 1] as usize;
+                if hi > lo {
+                    visit(lo..hi);
+                }
+            }
+        }
+    }
+
     /// The group that starts at sorted particle `first`: the particles after it, up to
     /// `end` and [`LANES`] in all, that lie in its row of cells (same y and z), `x(k)` being
     /// where particle k is. A group shares its neighbour rows, so the vectorised passes take
@@ -277,6 +295,51 @@ mod tests {
                 .floor()
                 .clamp(0.0, hi) as i32
         })
+    }
+
+    /// Every particle inside a box lies in a row `rows_in_box` visits, for boxes from a tenth
+    /// of a cell to three cells wide anywhere on the grid, across cell edges and its border.
+    #[test]
+    fn a_box_s_rows_hold_every_particle_in_it() {
+        let mut sim = SimParams::zeroed();
+        let cell = 0.017;
+        sim.grid_dims = [12, 9, 1, 0];
+        sim.grid_origin = [0.0, 0.0, 0.0, 1.0 / cell];
+        sim.n_cells = 12 * 9;
+        let mut grid = Grid::new(&sim, 2);
+        // A lattice of dp = 0.01 shaken by up to 0.4 dp, some of it outside the grid.
+        let mut seed = 11u32;
+        let mut shake = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / 16_777_216.0 - 0.5
+        };
+        let mut pos = Vec::new();
+        for iy in 0..16 {
+            for ix in 0..22 {
+                let x = (ix as f32 - 0.5) * 0.01 + 0.008 * shake();
+                let y = (iy as f32 - 0.5) * 0.01 + 0.008 * shake();
+                pos.push([x, y, 0.0, 0.0]);
+            }
+        }
+        let ids: Vec<u32> = (0..pos.len() as u32).collect();
+        let order = grid.sort(&pos, &ids, None);
+        let pos = gather(&pos, &order);
+        let (mut inside, mut straddling) = (0, 0);
+        for _ in 0..400 {
+            let at = [0.2 * shake() + 0.1, 0.15 * shake() + 0.07, 0.0];
+            let half = cell * (0.05 + 1.45 * (shake() + 0.5));
+            let (lo, hi) = (at.map(|a| a - half), at.map(|a| a + half));
+            let mut seen = vec![false; pos.len()];
+            grid.rows_in_box(&lo, &hi, |range| range.for_each(|j| seen[j] = true));
+            for (j, x) in pos.iter().enumerate() {
+                if (0..2).all(|k| (lo[k]..=hi[k]).contains(&x[k])) {
+                    assert!(seen[j], "{x:?} in the box {lo:?} .. {hi:?}");
+                    inside += 1;
+                }
+            }
+            straddling += usize::from(grid.coords(&lo) != grid.coords(&hi));
+        }
+        assert!(inside > 2000 && straddling > 300, "{inside} {straddling}");
     }
 
     #[test]

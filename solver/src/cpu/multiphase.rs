@@ -141,17 +141,24 @@ pub fn rheology_pass(
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
     type Sleep = (Vec<bool>, Vec<bool>);
-    let (vol, (sides, (asleep, recordable))): (Vec<f32>, (Vec<RheologySide>, Sleep)) = pool
+    type Own = (Vec<f32>, Vec<(f32, u32)>);
+    let ((vol, fluxes), (sides, (asleep, recordable))): (Own, (Vec<RheologySide>, Sleep)) = pool
         .install(|| {
             (0..n)
                 .into_par_iter()
                 .map(|i| {
                     let side = pass.side(&pos[i], &vel[i]);
                     let state = state(i, &side.x);
-                    (pass.volume(&pos[i], &vel[i]), (side, state))
+                    // In sorted order: the loads are summed and weighed in that order.
+                    let flux = holds.fluxes.get(holds.ids[i] as usize);
+                    let flux = *flux.unwrap_or(&(NO_FLUX, NO_TARGET));
+                    ((pass.volume(&pos[i], &vel[i]), flux), (side, state))
                 })
                 .unzip()
         });
+    // Read only where the pass wears the bed (`Rheology::exchange_of`).
+    let wears = exner && holds.draws.is_some();
+    let passed = wears.then(|| passed(&fluxes, holds.ids, holds.fluxes.len()));
     let pairs = Pairs {
         params,
         pass: &pass,
@@ -161,11 +168,11 @@ pub fn rheology_pass(
         vol: &vol,
         sides: &sides,
         ids: holds.ids,
-        fluxes: holds.fluxes,
+        fluxes: &fluxes,
+        passed: passed.as_deref().unwrap_or_default(),
         words: holds.words,
         asleep: &asleep,
         bed_tops: exner.then_some(holds.bed_tops),
-        named: named.as_deref(),
         deep: deep.as_ref(),
         recordable: &recordable,
         records: holds.records,
@@ -263,6 +270,22 @@ fn named(fluxes: &[(f32, u32)]) -> Vec<bool> {
     named
 }
 
+/// By id, the bed load passed to each particle in the last pass that drew: the loads of the
+/// particles that named it, `fluxes` and `ids` in sorted order, summed in that order, as a
+/// walk over its neighbours ([`Exchange::add`]) sums them.
+fn passed(fluxes: &[(f32, u32)], ids: &[u32], by_id: usize) -> Vec<f32> {
+    let mut passed = vec![0.0f32; by_id];
+    for (&(flux, target), &id) in fluxes.iter().zip(ids) {
+        if flux < 0.0 || target == id {
+            continue;
+        }
+        if let Some(p) = passed.get_mut(target as usize) {
+            *p += flux;
+        }
+    }
+    passed
+}
+
 /// What a particle that exchanges no bed load is passed, and where its own goes.
 const NONE_PASSED: (f32, u32) = (0.0, NO_TARGET);
 
@@ -279,8 +302,11 @@ struct Pairs<'a> {
     vol: &'a [f32],
     sides: &'a [RheologySide],
     ids: &'a [u32],
-    /// The last pass's bed load and where it went, by id (`Holds::fluxes`).
+    /// The last pass's bed load and where it went (`Holds::fluxes`), in sorted order.
     fluxes: &'a [(f32, u32)],
+    /// Under `van_rijn_exner`, the bed load passed to each particle in the last pass, by id
+    /// ([`passed`]); empty otherwise.
+    passed: &'a [f32],
     /// The region words of the last pass.
     words: &'a [u32],
     /// The grains that may sleep in this pass.
@@ -288,8 +314,6 @@ struct Pairs<'a> {
     /// Under `van_rijn_exner`, [`Holds::bed_tops`]: a sleeper at the bed's top offers to take
     /// load.
     bed_tops: Option<&'a [u8]>,
-    /// Under `van_rijn_exner`, whether the last pass that drew named each particle, by id.
-    named: Option<&'a [bool]>,
     /// Where held grains under the water may sleep: the rule, whether each particle's walk
     /// leaves a record, and the records of the last walks by id ([`deep`]).
     deep: Option<&'a Deep>,
@@ -348,27 +372,28 @@ impl Pairs<'_> {
         asleep
     }
 
-    /// The bed load passed to particle `i` in the last pass and the particle it passes its own
-    /// to, from its sums `s` (none without deposition): the cells within reach hold both, since
-    /// each lies within 2 dp of `i`.
+    /// The bed load passed to particle `i` in the last pass ([`passed`]) and the particle it
+    /// passes its own to, from its sums `s` (none without deposition): the one it names lies
+    /// within dp of the point dp down the flow, so only the cells around that point are
+    /// weighed.
     fn exchange(&self, i: usize, s: &RheologySums) -> (f32, u32) {
         let x = &self.pos[i];
         let id = self.ids[i];
         let Some(mut ex) = self.pass.exchange_of((x, id), s, self.words[i]) else {
             return NONE_PASSED;
         };
-        // Most of the bed neither names nor was named: nothing to weigh.
-        if !ex.names() && !self.named.is_none_or(|n| n[id as usize]) {
-            return NONE_PASSED;
-        }
-        self.grid
-            .rows(self.grid.coords(&[x[0], x[1], x[2]]), |range| {
+        let passed = self.passed.get(id as usize).copied().unwrap_or(0.0);
+        if ex.names() {
+            // A box a little wider than the disc: no rounding leaves a point of it out.
+            let (at, radius) = ex.reach();
+            let (lo, hi) = (at.map(|a| a - 1.01 * radius), at.map(|a| a + 1.01 * radius));
+            self.grid.rows_in_box(&lo, &hi, |range| {
                 for j in range {
-                    let id_j = self.ids[j];
-                    ex.add(&self.pos[j], id_j, self.fluxes[id_j as usize]);
+                    ex.weigh(&self.pos[j], self.ids[j], self.fluxes[j].0);
                 }
             });
-        ex.outcome()
+        }
+        (passed, ex.outcome().1)
     }
 
     /// The sums of `group`, from each particle's own start.

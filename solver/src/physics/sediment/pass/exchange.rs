@@ -15,6 +15,8 @@ pub const NO_TARGET: u32 = u32::MAX;
 #[derive(Clone, Copy, Debug)]
 pub struct Exchange {
     at: [f32; 3],
+    /// How far from `at` a neighbour may be named: dp, or 0 under no flow.
+    radius: f32,
     id: u32,
     d2: f32,
     target: u32,
@@ -29,6 +31,7 @@ impl Exchange {
         let flow = along.unwrap_or([0.0; 3]);
         Exchange {
             at: std::array::from_fn(|k| from[k] + dp * flow[k]),
+            radius: if along.is_some() { dp } else { 0.0 },
             id,
             // Nothing lies nearer the point than 0: a particle under no flow names none.
             d2: if along.is_some() { dp * dp } else { 0.0 },
@@ -47,6 +50,26 @@ impl Exchange {
         if target_j == self.id {
             self.passed += flux_j;
         }
+        self.weigh_target(x_j, id_j);
+    }
+
+    /// Weighs neighbour `id_j` at `x_j`, as [`Exchange::add`] does, as the particle to pass the
+    /// load to only: for a caller that sums what was passed to the particle apart, in the same
+    /// order (`cpu::multiphase`). Only a neighbour within [`Exchange::reach`] can be named.
+    pub fn weigh(&mut self, x_j: &[f32; 4], id_j: u32, flux_j: f32) {
+        if flux_j < 0.0 || id_j == self.id {
+            return;
+        }
+        self.weigh_target(x_j, id_j);
+    }
+
+    /// The point dp down the flow and the distance from it within which a neighbour may be
+    /// named (none under no flow).
+    pub fn reach(&self) -> ([f32; 3], f32) {
+        (self.at, self.radius)
+    }
+
+    fn weigh_target(&mut self, x_j: &[f32; 4], id_j: u32) {
         let d2: f32 = (0..3).map(|k| (x_j[k] - self.at[k]).powi(2)).sum();
         // The lesser id of two at the same distance: the same choice in any order.
         let tie = d2 == self.d2 && self.target != NO_TARGET && id_j < self.target;
@@ -96,6 +119,24 @@ mod tests {
         let mut ex = at_origin();
         ex.add(&[DP, -DP, 0.0, 0.0], 3, (0.1, NO_TARGET));
         assert_eq!(ex.outcome(), (0.0, NO_TARGET), "a dp from the point");
+    }
+
+    /// `weigh` names as `add` does and sums nothing passed; `reach` is the point dp down the
+    /// flow and dp around it, nothing under no flow.
+    #[test]
+    fn weighing_names_as_adding_does_within_its_reach() {
+        let near = ([1.6 * DP, 0.7 * DP, 0.0, 0.0], 9, (0.25, 5));
+        let nearer = ([0.5 * DP, -0.6 * DP, 0.0, 0.0], 8, (0.5, 2));
+        let (mut added, mut weighed) = (at_origin(), at_origin());
+        for (x, id, flux) in [near, nearer] {
+            added.add(&x, id, flux);
+            weighed.weigh(&x, id, flux.0);
+        }
+        assert_eq!(added.outcome(), (0.25, 8));
+        assert_eq!(weighed.outcome(), (0.0, 8));
+        assert_eq!(at_origin().reach(), ([DP, 0.0, 0.0], DP));
+        let still = Exchange::new(5, [0.0; 3], None, DP);
+        assert_eq!(still.reach().1, 0.0);
     }
 
     /// It is passed the loads of those that named it and of no other; a particle not held at
