@@ -135,19 +135,32 @@ impl Grid {
     /// Calls `visit` with the sorted-index range of each row of cells within reach of cell
     /// `c`, as `stencil_row` in neighbours.wgsl: (2R + 1) rows in 2-D, (2R + 1)^2 in 3-D.
     #[inline]
-    pub fn rows(&self, c: [i32; 3], mut visit: impl FnMut(Range<usize>)) {
+    pub fn rows(&self, c: [i32; 3], visit: impl FnMut(Range<usize>)) {
         let r = self.reach;
         // In 2-D the grid is one cell deep: the one plane z = 0.
-        let (z_lo, z_hi) = ((c[2] - r).max(0), (c[2] + r).min(self.dims[2] - 1));
-        let x0 = (c[0] - r).max(0);
-        let x1 = (c[0] + r).min(self.dims[0] - 1);
-        for z in z_lo..=z_hi {
-            for y in (c[1] - r).max(0)..=(c[1] + r).min(self.dims[1] - 1) {
+        let lo = std::array::from_fn(|k| (c[k] - r).max(0));
+        let hi = std::array::from_fn(|k| (c[k] + r).min(self.dims[k] - 1));
+        self.rows_between(lo, hi, visit);
+    }
+
+    /// Calls `visit` with the sorted-index range of each row of cells that holds a part of
+    /// the box from `lo` to `hi`, in the order of [`Grid::rows`]: every particle in the box
+    /// is in one of them.
+    #[inline]
+    pub fn rows_in_box(&self, lo: &[f32; 3], hi: &[f32; 3], visit: impl FnMut(Range<usize>)) {
+        self.rows_between(self.coords(lo), self.coords(hi), visit);
+    }
+
+    /// The rows of the cells from `lo` to `hi` (inside the grid), z, then y, ascending.
+    #[inline(always)]
+    fn rows_between(&self, lo: [i32; 3], hi: [i32; 3], mut visit: impl FnMut(Range<usize>)) {
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
                 let base = self.index([0, y, z]);
-                let lo = self.starts[base + x0 as usize] as usize;
-                let hi = self.starts[base + x1 as usize + 1] as usize;
-                if hi > lo {
-                    visit(lo..hi);
+                let first = self.starts[base + lo[0] as usize] as usize;
+                let end = self.starts[base + hi[0] as usize + 1] as usize;
+                if end > first {
+                    visit(first..end);
                 }
             }
         }
@@ -155,24 +168,6 @@ impl Grid {
 }
 
 impl Grid {
-    /// Calls `visit` with the sorted-index range of each row of cells that holds a part of
-    /// the box from `lo` to `hi`, in the order of [`Grid::rows`]: every particle in the box
-    /// is in one of them.
-    #[inline]
-    pub fn rows_in_box(&self, lo: &[f32; 3], hi: &[f32; 3], mut visit: impl FnMut(Range<usize>)) {
-        let (a, b) = (self.coords(lo), self.coords(hi));
-        for z in a[2]..=b[2] {
-            for y in a[1]..=b[1] {
-                let base = self.index([0, y, z]);
-                let lo = self.starts[base + a[0] as usize] as usize;
-                let hi = self.starts[base + b[0] as usize + 1] as usize;
-                if hi > lo {
-                    visit(lo..hi);
-                }
-            }
-        }
-    }
-
     /// The group that starts at sorted particle `first`: the particles after it, up to
     /// `end` and [`LANES`] in all, that lie in its row of cells (same y and z), `x(k)` being
     /// where particle k is. A group shares its neighbour rows, so the vectorised passes take

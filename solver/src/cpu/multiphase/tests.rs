@@ -245,3 +245,25 @@ fn held_grains_deep_under_the_water_sleep_by_their_last_walk() {
     assert_eq!(denser.asleep, first.asleep);
     assert!(bits(&denser.out) == bits(&alone(&fx)));
 }
+
+/// The loads named to a grain are summed in sorted order, as its walk over its neighbours
+/// adds them: in f32, 4 + 4 + 1e8 is 1e8 + 8, where 1e8 + 4 + 4 rounds to 1e8. Loads of
+/// particles not at the bed's top, named to none or past the ids are passed to no one.
+#[test]
+fn the_loads_named_to_a_grain_are_summed_in_sorted_order() {
+    let fluxes = [
+        (4.0, 2),
+        (0.5, 3),
+        (4.0, 2),
+        (7.0, NO_TARGET),
+        (NO_FLUX, 3),
+        (1e8, 2),
+        (9.0, 60),
+        (2.0, 7),
+    ];
+    let ids = [0, 1, 4, 5, 8, 9, 6, 10];
+    let by_id = passed(&fluxes, &ids, 8);
+    let in_order = 4.0_f32 + 4.0 + 1e8;
+    assert_eq!(by_id, vec![0.0, 0.0, in_order, 0.5, 0.0, 0.0, 0.0, 2.0]);
+    assert_ne!(in_order, 1e8_f32 + 4.0 + 4.0, "the order must matter");
+}
