@@ -49,7 +49,6 @@ fn assert_nothing_leaks(
 /// With no inflow nothing enters, nothing erodes and the held bed stays exactly where it is.
 #[test]
 fn ulbra_with_no_inflow_erodes_nothing() {
-    let _l = common::gpu_lock();
     let backend = common::chosen();
     let mut c = ulbra_ci();
     if let Some(f) = c.open_flume.as_mut() {
@@ -135,7 +134,6 @@ fn assert_inlet_runs_at(sim: &Simulation, c: &Case, q: f64) {
 /// P1 at 2 s above that of a run at constant discharge.
 #[test]
 fn ulbra_discharge_series_drives_the_inlet_and_raises_the_gauges() {
-    let _l = common::gpu_lock();
     let backend = common::chosen();
     let c = ulbra_ci();
     let f = c.open_flume.clone().expect("open flume");
@@ -187,7 +185,6 @@ fn ulbra_discharge_series_drives_the_inlet_and_raises_the_gauges() {
 /// and 4, Eq. 25 satisfied), summed over samples every 0.1 s of the first 1.5 s.
 #[test]
 fn ulbra_erosion_grows_with_bed_roughness() {
-    let _l = common::gpu_lock();
     let backend = common::chosen();
     let mut eroded = Vec::new();
     for ks in [1.0, 7.0] {
@@ -334,7 +331,6 @@ fn assert_scour_hole(obs: &flume_solver::Observations, zs0: &[f64], dp: f64, t: 
 /// - mass is conserved, every particle keeps its phase; Zb never lies above Zs.
 #[test]
 fn louvain_dam_break_scours_below_the_gate_and_the_bed_holds() {
-    let _l = common::gpu_lock();
     let backend = common::chosen();
     let mut c = Case::from_path(&common::case_path(
         "../launch_configs/louvain_dambreak.yaml",
@@ -398,7 +394,6 @@ fn louvain_dam_break_scours_below_the_gate_and_the_bed_holds() {
 /// the run ends with the blow-up error instead, as it should.)
 #[test]
 fn a_sediment_blow_up_is_caught_and_recovered() {
-    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = Case::from_path(&common::case_path("tests/cases/sediment_bed_2d.yaml"))
         .expect("case parses");
@@ -424,7 +419,6 @@ fn a_sediment_blow_up_is_caught_and_recovered() {
 /// count is fixed and the mass balances once the collected sand is counted.
 #[test]
 fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
-    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c =
         Case::from_path(&common::case_path("tests/cases/collector_2d.yaml")).expect("case parses");
@@ -471,7 +465,6 @@ fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
 /// below a third by 1.4 s).
 #[test]
 fn falappi_flushing_scours_in_front_of_the_outlet_only() {
-    let _l = common::gpu_lock();
     let backend = common::chosen();
     let mut c = Case::from_path(&common::case_path(
         "../launch_configs/falappi_flushing.yaml",
@@ -560,7 +553,6 @@ fn falappi_flushing_scours_in_front_of_the_outlet_only() {
 /// inlet is never starved, the count is fixed and the mass balances at every second.
 #[test]
 fn a_flume_recycles_its_particles_without_loss() {
-    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c =
         Case::from_path(&common::case_path("tests/cases/recycle_2d.yaml")).expect("case parses");
