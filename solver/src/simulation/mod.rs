@@ -5,8 +5,12 @@
 //! schedule, the particles it places) is in `inflow`.
 
 mod chain;
+mod chunk;
+mod grid;
 mod inflow;
 mod pores;
+
+use grid::{divisions_of, grid_for};
 
 pub use inflow::{InflowSchedule, RefusedInflow};
 pub use pores::PoreColumns;
@@ -22,10 +26,10 @@ use crate::error::SolverError;
 use crate::flume::FlumeState;
 use crate::generate::{count, generate};
 use crate::gpu::engine::GpuEngine;
-use crate::health::{self, Culprit, ExclusionLog, RHO_RATIO_MAX};
+use crate::health::{self, ExclusionLog, RHO_RATIO_MAX};
 pub use crate::health::{Health, Recovery};
 use crate::observe::{self, FlumeObservation, Observations};
-use crate::particles::{Parking, ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
+use crate::particles::{ParticleRegion, Particles, SPLASH_ROOM, parked_phase};
 
 /// Retries of one chunk after a blow-up, each from the chunk's start at half the CFL number of
 /// the last try, before the blow-up is returned as an error.
@@ -37,9 +41,6 @@ pub const CFL_RESTORE_AFTER_CHUNKS: u32 = 50;
 /// Largest CFL number `set_cfl` accepts. Above about 1 the scheme is unstable: values up to
 /// this are accepted so that an operator (or a test) can see the recovery bring it back down.
 pub const MAX_CFL: f64 = 5.0;
-
-/// Largest number of steps recorded into one submission.
-const MAX_STEPS_PER_SUBMIT: u32 = 400;
 
 pub struct Simulation {
     engine: Box<dyn Engine>,
@@ -66,40 +67,6 @@ pub struct Simulation {
     /// Exclusions in one submission beyond which the run has blown up.
     max_excluded: u32,
     exclusion_log: ExclusionLog,
-}
-
-fn divisions_of(case: &Case, h: f64) -> u32 {
-    crate::gpu::pipeline::cell_divisions(case.dimension, h / case.numerics.dp_m)
-}
-
-/// Grid of cells of size 2h / cell_divisions covering the tank, its walls and a margin above it.
-fn grid_for(case: &Case, h: f64, n: u64) -> Result<([u32; 4], [f32; 4]), SolverError> {
-    let d = case.dim();
-    let cell = 2.0 * h / f64::from(divisions_of(case, h));
-    let margin = f64::from(case.walls.layers) * case.numerics.dp_m + cell;
-    let mut dims = [1u32; 4];
-    let mut origin = [0.0f32; 4];
-    for k in 0..d {
-        let lo = case.domain.min_m[k] - margin;
-        let mut hi = case.domain.max_m[k] + margin;
-        if k == d - 1 {
-            // Room above the tank for splashes; particles above the grid still live in its top row.
-            hi += SPLASH_ROOM * (case.domain.max_m[k] - case.domain.min_m[k]);
-            if case.open_flume.is_some() {
-                hi = hi.max(Parking::new(case, h).top(n) + margin);
-            }
-        }
-        dims[k] = ((hi - lo) / cell).ceil().clamp(1.0, f64::from(u32::MAX)) as u32;
-        origin[k] = lo as f32;
-    }
-    let cells = u64::from(dims[0]) * u64::from(dims[1]) * u64::from(dims[2]);
-    // Cell indices and the cell-start table (cells + 1 entries) are u32 on the GPU.
-    dims[3] = u32::try_from(cells)
-        .ok()
-        .filter(|c| *c < u32::MAX)
-        .ok_or(SolverError::TooManyCells(cells))?;
-    origin[3] = (1.0 / cell) as f32;
-    Ok((dims, origin))
 }
 
 impl Simulation {
@@ -394,104 +361,6 @@ impl Simulation {
         Ok(())
     }
 
-    /// Steps to `target_s` in submissions of up to `MAX_STEPS_PER_SUBMIT` steps. Each
-    /// submission is a GPU chunk whose time starts at zero, so f32 only ever holds the time
-    /// of a few hundred steps; the host adds it to its f64 clock.
-    fn run_chunk(&mut self, target_s: f64) -> Result<(), SolverError> {
-        let dp = self.case.numerics.dp_m;
-        while target_s > self.time_s {
-            let remaining = target_s - self.time_s;
-            let max_span = self
-                .flume
-                .as_ref()
-                .map_or(f64::INFINITY, |f| f.max_span_s(dp));
-            let span = remaining.min(max_span);
-            let euler_every = u64::from(self.params.euler_every);
-            // The run's step count wraps in the block: the pick-up draws only need it to differ
-            // from step to step.
-            let init = StepState::chunk(
-                span as f32,
-                (self.last_dt_s as f32, self.dt_taken),
-                (self.steps as u32, (self.steps % euler_every) as u32),
-            );
-            let state = self.engine.run(init, self.steps_for(span))?;
-            self.steps += u64::from(state.steps);
-            self.last_dt_s = f64::from(state.last_dt);
-            self.dt_taken = state.dt_taken;
-            let mut health = Health(state.status);
-            if state.excluded > self.max_excluded {
-                health.0 |= Health::MANY_EXCLUDED;
-            }
-            if !health.is_ok() {
-                self.time_s += f64::from(state.t_rel);
-                return Err(SolverError::BlowUp {
-                    time_s: self.time_s,
-                    step: self.steps,
-                    health,
-                    culprits: self.culprits(&state)?,
-                    recurring_cfl: None,
-                });
-            }
-            let reached = state.t_rel >= state.t_target;
-            let advanced = if reached {
-                span
-            } else {
-                f64::from(state.t_rel)
-            };
-            self.time_s = if reached && span == remaining {
-                target_s
-            } else {
-                self.time_s + advanced
-            };
-            // Only a chunk with exclusions has particles to name.
-            let rest = if state.excluded > 0 {
-                self.rest_densities()
-            } else {
-                Vec::new()
-            };
-            if let Some(f) = &mut self.flume {
-                f.eroded_particles += u64::from(state.eroded);
-                f.parked_particles += u64::from(state.parked);
-                f.excluded_particles += u64::from(state.excluded);
-                f.excluded_sediment += u64::from(state.excluded_sediment);
-                let logged = (state.excluded as usize).min(state.excluded_log.len());
-                let excluded = state.excluded_log[..logged]
-                    .iter()
-                    .map(|e| health::from_log(&self.case, &rest, e));
-                self.exclusion_log.note(
-                    self.time_s,
-                    state.excluded,
-                    excluded,
-                    f.excluded_particles,
-                );
-            }
-            self.feed_inlet(advanced)?;
-            self.soak_pores(advanced)?;
-        }
-        Ok(())
-    }
-
-    /// The particles to name in a blow-up report: those excluded in the failed chunk, then
-    /// the moving ones furthest from health, 8 in all.
-    fn culprits(&self, state: &StepState) -> Result<Vec<Culprit>, SolverError> {
-        const NAMED: usize = 8;
-        let rest = self.rest_densities();
-        let logged = (state.excluded as usize).min(state.excluded_log.len());
-        let mut out: Vec<Culprit> = state.excluded_log[..logged]
-            .iter()
-            .map(|e| health::from_log(&self.case, &rest, e))
-            .collect();
-        let particles = self.read_particles()?;
-        let worst = health::worst_particles(&self.case, &rest, &particles, NAMED);
-        out.extend(worst.into_iter().take(NAMED.saturating_sub(out.len())));
-        Ok(out)
-    }
-
-    /// Rest density of each GPU phase (walls and parked particles included), kg/m3.
-    fn rest_densities(&self) -> Vec<f64> {
-        self.derived.phases.iter().map(|p| p.rho0).collect()
-    }
-
     /// The acoustic CFL bound on the time step, CFL h / c0, s: no step is longer, so a run
     /// to a few times this takes at least that many steps.
     pub fn acoustic_dt_bound_s(&self) -> f64 {
@@ -501,19 +370,6 @@ impl Simulation {
     /// The open flume's host state (discharge, eroded and parked counts); None for a tank.
     pub fn flume(&self) -> Option<&FlumeState> {
         self.flume.as_ref()
-    }
-
-    /// Steps estimated to cover `span_s` at the last CFL step (or the acoustic bound before
-    /// the first step), clamped to one submission.
-    fn steps_for(&self, span_s: f64) -> u32 {
-        let dt = if self.last_dt_s > 0.0 {
-            self.last_dt_s
-        } else {
-            f64::from(self.params.cfl * self.params.h / self.params.c0)
-        };
-        (span_s / dt)
-            .ceil()
-            .clamp(1.0, f64::from(MAX_STEPS_PER_SUBMIT)) as u32
     }
 
     /// The particles as they are now, in id order (index i holds the particle generated i-th).
