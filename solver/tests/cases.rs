@@ -8,10 +8,11 @@ use flume_solver::{Backend, Case, Simulation};
 
 const CPU: Backend = Backend::cpu(2);
 
-/// Runs `check` on the CPU backend, then on the GPU when there is one: what it returns from
-/// each, CPU first.
+/// Runs `check` on the CPU backend, then on the GPU when there is one (one GPU test at a
+/// time): what it returns from each, CPU first.
 fn on_both<T>(check: impl Fn(Backend) -> T) -> (T, Option<T>) {
     let cpu = check(CPU);
+    let _l = common::gpu_lock();
     (cpu, common::gpu().map(|g| check(Backend::from(g))))
 }
 
@@ -93,6 +94,7 @@ fn hydrostatic_tank_3d_pressure_follows_depth() {
 /// the same 2 % as one phase (the interface lies halfway between the two blocks' lattices).
 #[test]
 fn two_phases_at_rest_keep_the_layered_hydrostatic_pressure() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = case("tests/cases/two_layer_2d.yaml");
     let g = c.gravity_magnitude();
@@ -324,6 +326,7 @@ fn check_dambreak_front(
 /// by the (cell, id) sort and every reduction is a min or max.
 #[test]
 fn dambreak_is_bit_identical_run_to_run_and_loses_nothing() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let gpu = Backend::from(gpu);
     assert_same_bits(&[gpu.clone(), gpu]);
@@ -374,6 +377,7 @@ fn assert_same_bits(backends: &[Backend]) {
 
 #[test]
 fn a_case_larger_than_the_adapter_allows_fails_before_allocating() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let mut c = case("tests/cases/hydrostatic_3d.yaml");
     // Enough particles to pass the per-binding limit of this adapter, whatever it is.
@@ -400,6 +404,7 @@ fn a_case_larger_than_the_adapter_allows_fails_before_allocating() {
 #[test]
 fn an_unknown_adapter_name_lists_the_available_ones() {
     let Some(_gpu) = common::gpu() else { return };
+    let _l = common::gpu_lock();
     let err = match flume_solver::GpuContext::with_adapter(Some("no-such-adapter-xyz")) {
         Ok(_) => panic!("matched a nonexistent adapter"),
         Err(e) => e.to_string(),
@@ -415,6 +420,7 @@ fn an_unknown_adapter_name_lists_the_available_ones() {
 /// with a state that is whole (finite, in the tank, every particle present).
 #[test]
 fn a_blow_up_is_caught_rolled_back_and_retried_with_a_smaller_cfl() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let mut c = case("../launch_configs/dambreak_water.yaml");
     c.numerics.dp_m = 0.005;
@@ -480,6 +486,7 @@ fn dambreak_with_c0(c0_m_per_s: f64, dp_m: f64) -> Case {
 /// range is refused when the simulation is built, with the c0 that would do.
 #[test]
 fn a_sound_speed_too_low_for_the_column_is_refused_up_front() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = dambreak_with_c0(0.2, 0.0025);
     let err = match Simulation::new(gpu, &c) {
@@ -497,6 +504,7 @@ fn a_sound_speed_too_low_for_the_column_is_refused_up_front() {
 /// the blow-up error after the retries, instead of returning garbage.
 #[test]
 fn an_unrecoverable_blow_up_is_an_error_that_says_so() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = dambreak_with_c0(4.0, 0.01);
     let mut sim = Simulation::new(gpu, &c).expect("case builds");
@@ -518,6 +526,7 @@ fn an_unrecoverable_blow_up_is_an_error_that_says_so() {
 /// before anything is generated or allocated (the product used to wrap in u32).
 #[test]
 fn a_grid_too_large_for_32_bit_cell_indices_is_refused() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let mut c = case("tests/cases/hydrostatic_2d.yaml");
     c.domain.max_m = vec![2000.0, 2000.0];
@@ -535,6 +544,7 @@ fn a_grid_too_large_for_32_bit_cell_indices_is_refused() {
 /// A target time that is not a finite number is refused, and the simulation stays usable.
 #[test]
 fn a_non_finite_target_time_is_refused() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = dambreak_with_c0(28.0, 0.01);
     let mut sim = Simulation::new(gpu, &c).expect("case builds");
@@ -555,11 +565,12 @@ fn a_non_finite_target_time_is_refused() {
 /// moves as a whole, so no sand particle may move by more than dp either, walls included (before
 /// walls were scaled to the fluid they touch, sand rose 2.3 cm up the side walls in these 2 s).
 /// Measured on 2026-12-02, on both backends alike: no sand particle moved by more than 0.03 dp
-/// in 2 s (this comment said up to 0.8 dp when the test was written). It runs on the backend `simulate` chooses (the CPU backend in CI, 10 s
-/// against lavapipe's 280 s).
+/// in 2 s (this comment said up to 0.8 dp when the test was written). It runs on the backend
+/// `simulate` chooses (the CPU backend in CI, 10 s against lavapipe's 280 s).
 #[test]
 fn a_sand_bed_under_still_water_does_not_creep() {
     let backend = common::chosen();
+    let _l = common::lock_for(&backend);
     let c = case("tests/cases/sediment_bed_2d.yaml");
     let half_dp = 0.5 * c.numerics.dp_m;
     let mut sim = Simulation::new(backend, &c).expect("case builds");

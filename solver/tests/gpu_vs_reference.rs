@@ -9,6 +9,7 @@ use common::stages::{self, case};
 
 /// Runs a shared stage check on the GPU, one GPU test at a time.
 fn on_gpu(check: impl FnOnce(&flume_solver::Backend)) {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     check(&flume_solver::Backend::from(gpu));
 }

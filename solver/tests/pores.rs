@@ -105,6 +105,7 @@ fn a_still_pool_soaks_into_the_dry_bed_at_green_ampts_rate_until_it_is_full() {
 /// (lavapipe in CI) takes the same water from the same columns.
 #[test]
 fn the_gpu_backend_soaks_the_bed_as_the_cpu_backend_does() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let (cpu, _) = soak(Backend::cpu(2), 0.5);
     let (gpu, sim) = soak(Backend::from(gpu), 0.5);

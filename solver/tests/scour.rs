@@ -50,6 +50,7 @@ fn assert_nothing_leaks(
 #[test]
 fn ulbra_with_no_inflow_erodes_nothing() {
     let backend = common::chosen();
+    let _l = common::lock_for(&backend);
     let mut c = ulbra_ci();
     if let Some(f) = c.open_flume.as_mut() {
         f.inflow_m3_per_s = 0.0;
@@ -135,6 +136,7 @@ fn assert_inlet_runs_at(sim: &Simulation, c: &Case, q: f64) {
 #[test]
 fn ulbra_discharge_series_drives_the_inlet_and_raises_the_gauges() {
     let backend = common::chosen();
+    let _l = common::lock_for(&backend);
     let c = ulbra_ci();
     let f = c.open_flume.clone().expect("open flume");
     let dp = c.numerics.dp_m;
@@ -186,6 +188,7 @@ fn ulbra_discharge_series_drives_the_inlet_and_raises_the_gauges() {
 #[test]
 fn ulbra_erosion_grows_with_bed_roughness() {
     let backend = common::chosen();
+    let _l = common::lock_for(&backend);
     let mut eroded = Vec::new();
     for ks in [1.0, 7.0] {
         let mut c = ulbra_ci();
@@ -332,6 +335,7 @@ fn assert_scour_hole(obs: &flume_solver::Observations, zs0: &[f64], dp: f64, t: 
 #[test]
 fn louvain_dam_break_scours_below_the_gate_and_the_bed_holds() {
     let backend = common::chosen();
+    let _l = common::lock_for(&backend);
     let mut c = Case::from_path(&common::case_path(
         "../launch_configs/louvain_dambreak.yaml",
     ))
@@ -394,6 +398,7 @@ fn louvain_dam_break_scours_below_the_gate_and_the_bed_holds() {
 /// the run ends with the blow-up error instead, as it should.)
 #[test]
 fn a_sediment_blow_up_is_caught_and_recovered() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c = Case::from_path(&common::case_path("tests/cases/sediment_bed_2d.yaml"))
         .expect("case parses");
@@ -419,6 +424,7 @@ fn a_sediment_blow_up_is_caught_and_recovered() {
 /// count is fixed and the mass balances once the collected sand is counted.
 #[test]
 fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c =
         Case::from_path(&common::case_path("tests/cases/collector_2d.yaml")).expect("case parses");
@@ -466,6 +472,7 @@ fn the_outlet_parks_what_spills_and_the_collector_counts_what_sinks() {
 #[test]
 fn falappi_flushing_scours_in_front_of_the_outlet_only() {
     let backend = common::chosen();
+    let _l = common::lock_for(&backend);
     let mut c = Case::from_path(&common::case_path(
         "../launch_configs/falappi_flushing.yaml",
     ))
@@ -553,6 +560,7 @@ fn falappi_flushing_scours_in_front_of_the_outlet_only() {
 /// inlet is never starved, the count is fixed and the mass balances at every second.
 #[test]
 fn a_flume_recycles_its_particles_without_loss() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c =
         Case::from_path(&common::case_path("tests/cases/recycle_2d.yaml")).expect("case parses");

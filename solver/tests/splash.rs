@@ -42,6 +42,7 @@ fn with_drop(case: &Case, at: [f32; 2], velocity: [f32; 2]) -> Option<(Simulatio
 /// every CFL).
 #[test]
 fn a_lone_drop_hitting_a_wall_is_excluded_and_the_run_goes_on() {
+    let _l = common::gpu_lock();
     let c = ulbra_ci_still();
     let Some((mut sim, id)) = with_drop(&c, [2.35, 0.06], [0.0, -5.0]) else {
         return;
@@ -69,6 +70,7 @@ fn a_lone_drop_hitting_a_wall_is_excluded_and_the_run_goes_on() {
 /// t = 2.65 s: it compresses about 12 % and bounces; nothing is excluded and nothing blows up.
 #[test]
 fn a_drop_at_the_speed_of_the_pit_splash_is_neither_excluded_nor_fatal() {
+    let _l = common::gpu_lock();
     let c = ulbra_ci_still();
     let Some((mut sim, id)) = with_drop(&c, [2.35, 0.04], [0.0, -1.2]) else {
         return;
@@ -94,6 +96,7 @@ fn a_drop_at_the_speed_of_the_pit_splash_is_neither_excluded_nor_fatal() {
 /// splashes: it is caught, rolled back and retried, and the flags say why.
 #[test]
 fn an_unstable_step_in_a_flume_is_still_a_blow_up() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let c =
         Case::from_path(&common::case_path("tests/cases/collector_2d.yaml")).expect("case parses");
@@ -117,6 +120,7 @@ fn an_unstable_step_in_a_flume_is_still_a_blow_up() {
 /// was.
 #[test]
 fn a_failure_at_the_same_time_at_a_smaller_step_is_reported_as_not_a_time_step_problem() {
+    let _l = common::gpu_lock();
     let c = ulbra_ci_still();
     let Some((mut sim, id)) = with_drop(&c, [1.5, 0.2], [f32::NAN, 0.0]) else {
         return;

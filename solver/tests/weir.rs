@@ -222,6 +222,7 @@ fn weir_as_generated(particles: &flume_solver::Particles, dp: f64, layers: u32) 
 /// level at P1 (wet from about 2 s) within a dp, and no water through a wall on either.
 #[test]
 fn the_cpu_and_wgpu_backends_agree_on_the_clear_water_flume() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let (case, _) = clear_water_ci(2.0);
     let run = |backend: Backend| {

@@ -18,6 +18,7 @@
 
 mod common;
 
+use common::gpu_lock;
 use common::probe::{Input, Probe, VULKAN_DIVISION, probe, same};
 use flume_solver::Region;
 use flume_solver::physics::eos;
@@ -61,6 +62,7 @@ fn one(x: f32) -> Input {
 
 #[test]
 fn kernel_and_equation_of_state() {
+    let _lock = gpu_lock();
     let Some(p) = probe() else { return };
     let h = p.params.h;
     let kernel = Wendland::new(h, p.params.dim);
@@ -100,6 +102,7 @@ fn kernel_and_equation_of_state() {
 
 #[test]
 fn the_shields_solve() {
+    let _lock = gpu_lock();
     let Some(p) = probe() else { return };
     let mut re: Vec<f32> = log_grid(1e-3, 1e4, 60);
     re.extend([0.0, -1.0, 499.99, 500.0, 500.01]);
@@ -164,6 +167,7 @@ fn the_shields_solve() {
 
 #[test]
 fn the_sediment_laws() {
+    let _lock = gpu_lock();
     let Some(p) = probe() else { return };
     let mat = &p.model.material;
     let mut strain = Vec::new();
@@ -249,6 +253,7 @@ fn region_inputs() -> Vec<RegionInputs> {
 
 #[test]
 fn the_region_and_its_viscosity() {
+    let _lock = gpu_lock();
     let Some(p) = probe() else { return };
     let flag = |b: bool| if b { 1.0 } else { 0.0 };
     let inputs: Vec<RegionInputs> = region_inputs();
@@ -318,6 +323,7 @@ fn the_region_and_its_viscosity() {
 /// threshold to T = 100, and whether a particle is picked up at chances from none to certain.
 #[test]
 fn the_pickup() {
+    let _lock = gpu_lock();
     let Some(p) = probe() else { return };
     let ids = [0u32, 1, 7, 4096, 65_535, 1 << 20, 0x8000_0001, u32::MAX];
     let steps = [0u32, 1, 2, 999, 1 << 16, 0xdead_beef, u32::MAX];
@@ -544,6 +550,7 @@ fn exner_alike(p: &Probe, pairs: &[(u32, u32)], halves: impl Fn(u32) -> [f32; 2]
 
 #[test]
 fn the_time_step() {
+    let _lock = gpu_lock();
     let Some(p) = probe() else { return };
     let (h, c0) = (p.params.h, p.params.c0);
     // Accelerations from none to a splash's, with and without the force bound, and the

@@ -13,6 +13,7 @@
 
 mod common;
 
+use common::gpu_lock;
 use common::probe::{Input, Probe, probe_of, same};
 use flume_solver::contract::SimParams;
 use flume_solver::gpu::shader;
@@ -166,6 +167,7 @@ fn case(path: &str, dp_m: f64) -> Case {
 
 #[test]
 fn the_store_rule_on_the_ulbra_flume() {
+    let _lock = gpu_lock();
     let mut flume = case("../launch_configs/ulbra_flume.yaml", 0.01);
     if let Some(f) = &mut flume.open_flume {
         f.reservoir_particles = 2500;
@@ -182,6 +184,7 @@ fn the_store_rule_on_the_ulbra_flume() {
 
 #[test]
 fn the_store_rule_at_a_bottom_outlet() {
+    let _lock = gpu_lock();
     let Some(probe) = probe_of(&case("../launch_configs/falappi_flushing.yaml", 0.02)) else {
         return;
     };

@@ -248,6 +248,7 @@ fn ulbra_runs_120_s_keeping_the_books() {
 /// resolution a gauge reads the surface at; 1 % of the reservoir is 25 particles.
 #[test]
 fn the_cpu_and_wgpu_backends_agree_on_the_ci_flume() {
+    let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
     let (cpu, _) = run(CPU, 6);
     let (wgpu, _) = run(Backend::from(gpu), 6);

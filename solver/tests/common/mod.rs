@@ -1,4 +1,4 @@
-//! Shared test helpers: the GPU (lavapipe in CI) and small case builders.
+//! Shared test helpers: the GPU (lavapipe in CI), serialised, and small case builders.
 
 #![allow(dead_code)]
 
@@ -10,7 +10,25 @@ pub mod sand_stages;
 pub mod stages;
 
 use flume_solver::{Backend, GpuContext, Particles};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
+
+/// GPU tests run one at a time; runs on the CPU backend take no lock. Measured on CI's kind of
+/// machine (two cores): a run on lavapipe keeps one core busy (user time equals wall time,
+/// whatever `LP_NUM_THREADS` says), and a run of the CI flume on the CPU backend's two threads
+/// about 1.2 cores; two such CPU runs side by side took 100 s against 165 s one after the
+/// other. Two lavapipe runs in two processes overlap as well (21.5 s each side by side, 25 s
+/// alone), but not in one: the four splash tests, two at a time on devices of their own, kept
+/// one core busy (68 s wall, 77 s user; another time 119 s wall), so the GPU's runs keep to
+/// one at a time.
+pub fn gpu_lock() -> MutexGuard<'static, ()> {
+    static LOCK: Mutex<()> = Mutex::new(());
+    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// [`gpu_lock`] where `backend` is a GPU; nothing for the CPU backend.
+pub fn lock_for(backend: &Backend) -> Option<MutexGuard<'static, ()>> {
+    matches!(backend, Backend::Gpu(_)).then(gpu_lock)
+}
 
 /// The backend `simulate` chooses (`Backend::choose`): `FLUME_TWIN_ADAPTER`, else a hardware
 /// GPU, else the CPU backend, which runs a flume some five times faster than lavapipe on the
@@ -21,17 +39,11 @@ pub fn chosen() -> Backend {
     Backend::choose().expect("FLUME_TWIN_ADAPTER names an adapter this machine has")
 }
 
-/// An adapter of its own, or None outside CI when this machine has none (then the test says so
-/// and passes); under CI=true a missing adapter fails the test, since CI has lavapipe.
-///
-/// The harness runs a binary's tests two at a time, GPU or not, with no lock between them.
-/// Measured on CI's kind of machine (two cores): a run on lavapipe keeps one core busy (user
-/// time equals wall time, whatever `LP_NUM_THREADS` says), and two of them, each on a device of
-/// its own, finished side by side in the time one took alone (21.5 s each against 25 s); two
-/// runs of the CI flume on the CPU backend's two threads each took 100 s side by side against
-/// 165 s one after the other (one such run keeps 1.2 cores busy on average).
+/// The adapter, or None outside CI when this machine has none (then the test says so and
+/// passes); under CI=true a missing adapter fails the test, since CI has lavapipe.
 pub fn gpu() -> Option<Arc<GpuContext>> {
-    match GpuContext::new() {
+    static GPU: OnceLock<Option<Arc<GpuContext>>> = OnceLock::new();
+    GPU.get_or_init(|| match GpuContext::new() {
         Ok(g) => {
             eprintln!("adapter: {}", g.adapter);
             Some(Arc::new(g))
@@ -43,7 +55,8 @@ pub fn gpu() -> Option<Arc<GpuContext>> {
             eprintln!("skipping GPU test: {e}");
             None
         }
-    }
+    })
+    .clone()
 }
 
 /// The particle phase of a case's sand: its second fluid phase (0 is the walls; every sediment
