@@ -16,10 +16,9 @@ use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 /// machine (two cores): a run on lavapipe keeps one core busy (user time equals wall time,
 /// whatever `LP_NUM_THREADS` says), and a run of the CI flume on the CPU backend's two threads
 /// about 1.2 cores; two such CPU runs side by side took 100 s against 165 s one after the
-/// other. Two lavapipe runs in two processes overlap as well (21.5 s each side by side, 25 s
-/// alone), but not in one: the four splash tests, two at a time on devices of their own, kept
-/// one core busy (68 s wall, 77 s user; another time 119 s wall), so the GPU's runs keep to
-/// one at a time.
+/// other. Lavapipe tests on an adapter each and with no lock were faster too (the splash tests
+/// 68 s against 87 s, `gpu_vs_reference.rs` 20 s against 34-44 s), measured once on a machine
+/// whose speed wandered by half; they keep to one at a time until a whole run settles it.
 pub fn gpu_lock() -> MutexGuard<'static, ()> {
     static LOCK: Mutex<()> = Mutex::new(());
     LOCK.lock().unwrap_or_else(|e| e.into_inner())
