@@ -8,8 +8,10 @@
 //! front crosses the dry bed in about 3 s, the sheet of grains it sets moving has come to rest by
 //! 5 s (ks/d50 = 1 and 3; at 7 it still creeps). At dp = 1 cm the flow moves no grain further
 //! than 3 cm, so the CI-size flume cannot show it. Three runs, ks/d50 = 1, 3 and 7, on the CPU
-//! backend, side by side on one thread each (its results do not depend on the thread count; two
-//! threads run one of these flumes only some 1.5 times faster than one).
+//! backend, side by side on one thread each: its results do not depend on the thread count
+//! (`cases.rs`), and two threads run the CI flume only some 1.5 times faster than one (README,
+//! speed), so three one-thread runs fill two cores better than three two-thread runs in turn
+//! (374.7 s against 533.3 s in whole runs of the suite).
 //!
 //! Each run's sand is followed by id (`flume_solver::budget`): the grains that reached the
 //! collector, the grains carried further than the budget's `FAR_M` (10 cm, its
