@@ -34,10 +34,28 @@ fi
 if command -v npm >/dev/null && [ ! -d tests/interop/foxglove_client/node_modules ]; then
   npm ci --prefix tests/interop/foxglove_client --no-audit --no-fund --loglevel=error
 fi
-# cargo's output ends with the doc-test runs ("0 passed"): a last line sums the whole suite.
+# Arguments before a `--` select what cargo builds (`-p flume-solver --test weir`); those after
+# it go to each test binary (`--nocapture`, a test's name).
+cargo_args=()
+while [ "$#" -gt 0 ] && [ "$1" != "--" ]; do
+  cargo_args+=("$1")
+  shift
+done
+if [ "$#" -gt 0 ]; then shift; fi
+# Built once; scripts/test_binaries.py then runs the binaries side by side, as many as there
+# are cores, and the doc tests last (cargo runs them only for a whole package). A last line sums
+# the whole suite.
 log="$(mktemp)"
+artifacts="$(mktemp)"
 status=0
-cargo test --release --workspace "$@" 2>&1 | tee "$log" || status=$?
+cargo test --release --workspace --no-run --message-format=json-render-diagnostics \
+  ${cargo_args[@]+"${cargo_args[@]}"} >"$artifacts" || status=$?
+if [ "$status" -eq 0 ]; then
+  python3 scripts/test_binaries.py "$artifacts" -- "$@" 2>&1 | tee "$log" || status=$?
+  if [ "${#cargo_args[@]}" -eq 0 ]; then
+    cargo test --release --workspace --doc -- "$@" 2>&1 | tee -a "$log" || status=$?
+  fi
+fi
 awk '/^test result:/ {
   for (i = 2; i <= NF; i++) {
     if ($i == "passed;") p += $(i - 1)
@@ -45,5 +63,5 @@ awk '/^test result:/ {
     if ($i == "ignored;") s += $(i - 1)
   }
 } END { printf "%d passed, %d failed, %d skipped\n", p, f, s }' "$log"
-rm -f "$log"
+rm -f "$log" "$artifacts"
 exit "$status"

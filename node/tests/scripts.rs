@@ -263,3 +263,69 @@ fn figure9_chart_draws_each_run_s_front_against_time() {
     assert!(!err.contains("Traceback"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// One cargo message naming a test executable of package `fake` (cargo's JSON layout).
+fn test_artifact(dir: &std::path::Path, name: &str) -> String {
+    let script = dir.join(name);
+    serde_json::json!({
+        "reason": "compiler-artifact",
+        "package_id": format!("path+file://{}#fake@0.1.0", dir.display()),
+        "manifest_path": dir.join("Cargo.toml"),
+        "target": {"name": name, "kind": ["test"], "src_path": dir.join(format!("tests/{name}.rs"))},
+        "profile": {"test": true},
+        "executable": script,
+    })
+    .to_string()
+}
+
+/// `test_binaries.py`, the suite's runner, on two fake test binaries run side by side: each
+/// one's output printed whole under its name, in its package's directory, the harness's
+/// arguments passed on, and a binary that fails makes the suite fail by name; a line that is
+/// not a cargo message is refused by its number, running nothing.
+#[test]
+fn the_test_runner_reports_each_binary_and_fails_when_one_fails() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = std::env::temp_dir().join(format!("flume-runner-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    for (name, body) in [
+        (
+            "good",
+            "echo \"in $(pwd) with $*\"; echo 'test result: ok. 2 passed;'",
+        ),
+        (
+            "bad",
+            "echo 'test result: FAILED. 0 passed; 1 failed;'; exit 101",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, format!("#!/bin/sh\n{body}\n")).expect("script");
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+    }
+    let artifacts = dir.join("artifacts.json");
+    let run = |lines: &[String]| {
+        std::fs::write(&artifacts, lines.join("\n")).expect("artifacts");
+        Command::new("python3")
+            .arg(repo_file("scripts/test_binaries.py"))
+            .arg(&artifacts)
+            .args(["--", "--nocapture"])
+            .env("TEST_LANES", "2")
+            .output()
+            .expect("python3 runs")
+    };
+    let out = run(&[test_artifact(&dir, "good"), test_artifact(&dir, "bad")]);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains(&format!("in {} with --nocapture", dir.display())),
+        "{text}"
+    );
+    assert!(text.contains("fake tests/bad.rs: exit 101"), "{text}");
+    assert!(text.contains("failed: fake tests/bad.rs"), "{text}");
+    assert!(!text.contains("failed: fake tests/good.rs"), "{text}");
+    let out = run(&[test_artifact(&dir, "good"), "{not json".into()]);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("artifacts.json:2"), "{err}");
+    assert!(String::from_utf8_lossy(&out.stdout).is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}
