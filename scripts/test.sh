@@ -42,17 +42,18 @@ while [ "$#" -gt 0 ] && [ "$1" != "--" ]; do
   shift
 done
 if [ "$#" -gt 0 ]; then shift; fi
+if [ "${#cargo_args[@]}" -eq 0 ]; then cargo_args=(--workspace); fi
 # Built once; scripts/test_binaries.py then runs the binaries side by side, as many as there
 # are cores, and the doc tests last (cargo runs them only for a whole package). A last line sums
 # the whole suite.
 log="$(mktemp)"
 artifacts="$(mktemp)"
 status=0
-cargo test --release --workspace --no-run --message-format=json-render-diagnostics \
-  ${cargo_args[@]+"${cargo_args[@]}"} >"$artifacts" || status=$?
+cargo test --release --no-run --message-format=json-render-diagnostics "${cargo_args[@]}" \
+  >"$artifacts" || status=$?
 if [ "$status" -eq 0 ]; then
   python3 scripts/test_binaries.py "$artifacts" -- "$@" 2>&1 | tee "$log" || status=$?
-  if [ "${#cargo_args[@]}" -eq 0 ]; then
+  if [ "${cargo_args[*]}" = "--workspace" ]; then
     cargo test --release --workspace --doc -- "$@" 2>&1 | tee -a "$log" || status=$?
   fi
 fi
