@@ -22,22 +22,22 @@ import tempfile
 import threading
 import time
 
-# Seconds each binary took in a whole run on two cores (CI=true), to start the longest first;
-# a binary not listed is taken as short. Only the order depends on these.
+# Seconds each binary took in the pool of a whole run on two cores (CI=true), to start the
+# longest first; a binary not listed is taken as short. Only the order depends on these.
 MEASURED_S = {
-    "flume-solver tests/whole_session.rs": 846,
-    "flume-solver tests/weir.rs": 616,
-    "flume-twin tests/whole_session.rs": 422,
-    "flume-solver tests/scour.rs": 408,
-    "flume-solver tests/roughness.rs": 387,
-    "flume-solver tests/cases.rs": 292,
-    "flume-solver tests/awake_set.rs": 212,
-    "flume-solver tests/splash.rs": 139,
-    "flume-solver tests/erosion_chain.rs": 97,
-    "flume-solver tests/front_step.rs": 91,
-    "flume-solver tests/pores.rs": 72,
-    "flume-solver tests/pickup.rs": 50,
-    "flume-solver tests/gpu_vs_reference.rs": 44,
+    "flume-solver tests/weir.rs": 753,
+    "flume-solver tests/whole_session.rs": 649,
+    "flume-twin tests/whole_session.rs": 576,
+    "flume-solver tests/roughness.rs": 471,
+    "flume-solver tests/cases.rs": 444,
+    "flume-solver tests/scour.rs": 406,
+    "flume-solver tests/awake_set.rs": 144,
+    "flume-solver tests/front_step.rs": 85,
+    "flume-solver tests/erosion_chain.rs": 79,
+    "flume-solver tests/splash.rs": 72,
+    "flume-solver tests/pores.rs": 46,
+    "flume-solver tests/pickup.rs": 40,
+    "flume-solver tests/gpu_vs_reference.rs": 36,
 }
 # The node's binaries that need no machine to themselves.
 POOLED_NODE = {"flume-twin tests/whole_session.rs"}
