@@ -9,13 +9,13 @@ runs at CI size on two threads about 1.2, so on two cores the second sat idle mu
 Here the binaries that only compute share a pool of one lane per core, longest first; those
 that serve DDS, WebSockets or shared memory against wall-clock deadlines (the node's, but its
 whole-session replay, which writes files) run afterwards one at a time, with the machine to
-themselves, as cargo ran them. Each binary runs in its package's directory, as under `cargo
+themselves, as cargo ran them. The two binaries whose lavapipe runs grow to gigabytes (APART)
+never run at once. Each binary runs in its package's directory, as under `cargo
 test`. The exit status is 1 when any binary failed, 2 on bad input.
 """
 
 import json
 import os
-import queue
 import subprocess
 import sys
 import tempfile
@@ -41,6 +41,9 @@ MEASURED_S = {
 }
 # The node's binaries that need no machine to themselves.
 POOLED_NODE = {"flume-twin tests/whole_session.rs"}
+# Binaries whose wgpu runs of the CI flume on lavapipe grow to 8-10 GB (the process grows
+# about 22 MB/s while they run): never two of them at once on a 24 GiB machine.
+APART = {"flume-solver tests/whole_session.rs", "flume-solver tests/weir.rs"}
 
 
 class Binary:
@@ -86,18 +89,26 @@ def package_name(message):
 
 
 def run(binary, args):
-    """Runs one binary to its end: (exit status, output, wall s, CPU s of it and its children)."""
+    """Runs one binary to its end: (exit status, output, wall s, CPU s of it and its children,
+    the largest resident size of it or a child, GB)."""
     with tempfile.TemporaryFile() as out:
         started = time.monotonic()
-        child = subprocess.Popen(
-            [binary.executable, *args], cwd=binary.directory, stdout=out, stderr=subprocess.STDOUT
-        )
+        try:
+            child = subprocess.Popen(
+                [binary.executable, *args],
+                cwd=binary.directory,
+                stdout=out,
+                stderr=subprocess.STDOUT,
+            )
+        except OSError as e:
+            return 127, f"cannot run {binary.executable}: {e}\n", 0.0, 0.0, 0.0
         _, status, usage = os.wait4(child.pid, 0)
         child.returncode = os.waitstatus_to_exitcode(status)
         wall = time.monotonic() - started
         out.seek(0)
         text = out.read().decode("utf-8", errors="replace")
-    return child.returncode, text, wall, usage.ru_utime + usage.ru_stime
+    cpu = usage.ru_utime + usage.ru_stime
+    return child.returncode, text, wall, cpu, usage.ru_maxrss / 1e6
 
 
 class Report:
@@ -108,34 +119,51 @@ class Report:
         self.failed = []
         self.times = []
 
-    def ended(self, binary, code, text, wall, cpu):
+    def ended(self, binary, code, text, wall, cpu, gb):
         with self.lock:
             print(f"     Running {binary.label} ({binary.executable})", flush=False)
             print(text, end="" if text.endswith("\n") else "\n")
-            print(f"     {binary.label}: exit {code}, {wall:.1f} s wall, {cpu:.1f} s CPU", flush=True)
-            self.times.append((wall, cpu, binary.label))
+            print(
+                f"     {binary.label}: exit {code}, {wall:.1f} s wall, {cpu:.1f} s CPU, {gb:.2f} GB",
+                flush=True,
+            )
+            self.times.append((wall, cpu, gb, binary.label))
             if code != 0:
                 self.failed.append(binary.label)
 
     def table(self):
         """The binaries that took over a second, longest first: where the suite's time goes."""
-        for wall, cpu, label in sorted(self.times, reverse=True):
+        for wall, cpu, gb, label in sorted(self.times, reverse=True):
             if wall >= 1.0:
-                print(f"{wall:8.1f} s wall {cpu:8.1f} s CPU  {label}")
+                print(f"{wall:8.1f} s wall {cpu:8.1f} s CPU {gb:6.2f} GB  {label}")
 
 
 def run_pool(binaries, args, lanes, report):
-    jobs = queue.Queue()
-    for b in sorted(binaries, key=lambda b: -MEASURED_S.get(b.label, 0)):
-        jobs.put(b)
+    """Each lane takes the longest binary left that may start: one of APART only while no
+    other of them runs."""
+    waiting = sorted(binaries, key=lambda b: -MEASURED_S.get(b.label, 0))
+    apart_running = [False]
+    changed = threading.Condition()
+
+    def take():
+        with changed:
+            while waiting:
+                for k, b in enumerate(waiting):
+                    if not (b.label in APART and apart_running[0]):
+                        apart_running[0] |= b.label in APART
+                        return waiting.pop(k)
+                changed.wait()
+            return None
 
     def lane():
-        while True:
+        while (b := take()) is not None:
             try:
-                b = jobs.get_nowait()
-            except queue.Empty:
-                return
-            report.ended(b, *run(b, args))
+                report.ended(b, *run(b, args))
+            finally:
+                with changed:
+                    if b.label in APART:
+                        apart_running[0] = False
+                    changed.notify_all()
 
     threads = [threading.Thread(target=lane) for _ in range(lanes)]
     for t in threads:

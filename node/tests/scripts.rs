@@ -264,38 +264,50 @@ fn figure9_chart_draws_each_run_s_front_against_time() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// One cargo message naming a test executable of package `fake` (cargo's JSON layout).
-fn test_artifact(dir: &std::path::Path, name: &str) -> String {
-    let script = dir.join(name);
+/// One cargo message naming the test executable `dir/name` of `package`, from `tests/source`
+/// (cargo's JSON layout).
+fn test_artifact(dir: &std::path::Path, package: &str, name: &str, source: &str) -> String {
     serde_json::json!({
         "reason": "compiler-artifact",
-        "package_id": format!("path+file://{}#fake@0.1.0", dir.display()),
+        "package_id": format!("path+file://{}#{package}@0.1.0", dir.display()),
         "manifest_path": dir.join("Cargo.toml"),
-        "target": {"name": name, "kind": ["test"], "src_path": dir.join(format!("tests/{name}.rs"))},
+        "target": {"name": name, "kind": ["test"], "src_path": dir.join("tests").join(source)},
         "profile": {"test": true},
-        "executable": script,
+        "executable": dir.join(name),
     })
     .to_string()
 }
 
-/// `test_binaries.py`, the suite's runner, on two fake test binaries run side by side: each
-/// one's output printed whole under its name, in its package's directory, the harness's
-/// arguments passed on, and a binary that fails makes the suite fail by name; a line that is
-/// not a cargo message is refused by its number, running nothing.
+/// `test_binaries.py`, the suite's runner, on fake test binaries (shell scripts) run two at a
+/// time: each one's output printed whole under its name, in its package's directory, the
+/// harness's arguments passed on; a binary that fails, or cannot start, makes the suite fail
+/// by name; the two binaries whose lavapipe runs grow to gigabytes never overlap, though a
+/// lane is free beside the first (each takes 1 s, and they are the longest, so they would start
+/// together); a line that is not a cargo message is refused by its number, running nothing.
 #[test]
 fn the_test_runner_reports_each_binary_and_fails_when_one_fails() {
     use std::os::unix::fs::PermissionsExt;
     let dir = std::env::temp_dir().join(format!("flume-runner-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
+    let spans = dir.join("spans");
+    let span = |name: &str| {
+        format!(
+            "echo \"{name} $(date +%s.%N) start\" >> {0}; sleep 1; \
+             echo \"{name} $(date +%s.%N) end\" >> {0}",
+            spans.display()
+        )
+    };
     for (name, body) in [
         (
             "good",
-            "echo \"in $(pwd) with $*\"; echo 'test result: ok. 2 passed;'",
+            "echo \"in $(pwd) with $*\"; echo 'test result: ok. 2 passed;'".into(),
         ),
         (
             "bad",
-            "echo 'test result: FAILED. 0 passed; 1 failed;'; exit 101",
+            "echo 'test result: FAILED. 0 passed; 1 failed;'; exit 101".into(),
         ),
+        ("weir", span("weir")),
+        ("session", span("session")),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, format!("#!/bin/sh\n{body}\n")).expect("script");
@@ -312,7 +324,13 @@ fn the_test_runner_reports_each_binary_and_fails_when_one_fails() {
             .output()
             .expect("python3 runs")
     };
-    let out = run(&[test_artifact(&dir, "good"), test_artifact(&dir, "bad")]);
+    let out = run(&[
+        test_artifact(&dir, "fake", "good", "good.rs"),
+        test_artifact(&dir, "fake", "bad", "bad.rs"),
+        test_artifact(&dir, "fake", "missing", "missing.rs"),
+        test_artifact(&dir, "flume-solver", "weir", "weir.rs"),
+        test_artifact(&dir, "flume-solver", "session", "whole_session.rs"),
+    ]);
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     assert_eq!(out.status.code(), Some(1), "{text}");
     assert!(
@@ -320,9 +338,29 @@ fn the_test_runner_reports_each_binary_and_fails_when_one_fails() {
         "{text}"
     );
     assert!(text.contains("fake tests/bad.rs: exit 101"), "{text}");
-    assert!(text.contains("failed: fake tests/bad.rs"), "{text}");
-    assert!(!text.contains("failed: fake tests/good.rs"), "{text}");
-    let out = run(&[test_artifact(&dir, "good"), "{not json".into()]);
+    assert!(
+        text.contains("failed: fake tests/bad.rs, fake tests/missing.rs")
+            || text.contains("failed: fake tests/missing.rs, fake tests/bad.rs"),
+        "{text}"
+    );
+    let spans = std::fs::read_to_string(&spans).expect("the apart binaries ran");
+    let times: Vec<(&str, f64)> = spans
+        .lines()
+        .map(|l| {
+            let mut w = l.split(' ');
+            let name = w.next().expect("name");
+            (name, w.next().expect("time").parse().expect("seconds"))
+        })
+        .collect();
+    let (first, second) = (&times[..2], &times[2..]);
+    assert!(
+        first[0].0 == first[1].0 && second[0].0 == second[1].0 && first[1].1 <= second[0].1,
+        "the two ran at once: {spans}"
+    );
+    let out = run(&[
+        test_artifact(&dir, "fake", "good", "good.rs"),
+        "{not json".into(),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("artifacts.json:2"), "{err}");
