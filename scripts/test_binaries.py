@@ -142,27 +142,28 @@ def run_pool(binaries, args, lanes, report):
     """Each lane takes the longest binary left that may start: one of APART only while no
     other of them runs."""
     waiting = sorted(binaries, key=lambda b: -MEASURED_S.get(b.label, 0))
-    apart_running = [False]
+    apart_running = False
     changed = threading.Condition()
 
     def take():
+        nonlocal apart_running
         with changed:
             while waiting:
                 for k, b in enumerate(waiting):
-                    if not (b.label in APART and apart_running[0]):
-                        apart_running[0] |= b.label in APART
+                    if b.label not in APART or not apart_running:
+                        apart_running |= b.label in APART
                         return waiting.pop(k)
                 changed.wait()
             return None
 
     def lane():
+        nonlocal apart_running
         while (b := take()) is not None:
             try:
                 report.ended(b, *run(b, args))
             finally:
                 with changed:
-                    if b.label in APART:
-                        apart_running[0] = False
+                    apart_running &= b.label not in APART
                     changed.notify_all()
 
     threads = [threading.Thread(target=lane) for _ in range(lanes)]

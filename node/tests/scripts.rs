@@ -333,10 +333,12 @@ fn the_test_runner_reports_each_binary_and_fails_when_one_fails() {
     ]);
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     assert_eq!(out.status.code(), Some(1), "{text}");
-    assert!(
-        text.contains(&format!("in {} with --nocapture", dir.display())),
-        "{text}"
+    let good = format!(
+        "Running fake tests/good.rs ({})\nin {} with --nocapture\n",
+        dir.join("good").display(),
+        dir.display()
     );
+    assert!(text.contains(&good), "{text}");
     assert!(text.contains("fake tests/bad.rs: exit 101"), "{text}");
     assert!(
         text.contains("failed: fake tests/bad.rs, fake tests/missing.rs")
