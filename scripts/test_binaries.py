@@ -9,8 +9,8 @@ runs at CI size on two threads about 1.2, so on two cores the second sat idle mu
 Here the binaries that only compute share a pool of one lane per core, longest first; those
 that serve DDS, WebSockets or shared memory against wall-clock deadlines (the node's, but its
 whole-session replay, which writes files) run afterwards one at a time, with the machine to
-themselves, as cargo ran them. The two binaries whose lavapipe runs grow to gigabytes (APART)
-never run at once. Each binary runs in its package's directory, as under `cargo
+themselves, as cargo ran them. The two binaries whose runs grow to gigabytes on Mesa 22.3's lavapipe
+(APART) never run at once. Each binary runs in its package's directory, as under `cargo
 test`. The exit status is 1 when any binary failed, 2 on bad input.
 """
 
@@ -25,24 +25,25 @@ import time
 # Seconds each binary took in the pool of a whole run on two cores (CI=true), to start the
 # longest first; a binary not listed is taken as short. Only the order depends on these.
 MEASURED_S = {
-    "flume-solver tests/weir.rs": 753,
-    "flume-solver tests/whole_session.rs": 649,
-    "flume-twin tests/whole_session.rs": 576,
-    "flume-solver tests/roughness.rs": 471,
-    "flume-solver tests/cases.rs": 444,
-    "flume-solver tests/scour.rs": 406,
-    "flume-solver tests/awake_set.rs": 144,
-    "flume-solver tests/front_step.rs": 85,
-    "flume-solver tests/erosion_chain.rs": 79,
-    "flume-solver tests/splash.rs": 72,
-    "flume-solver tests/pores.rs": 46,
-    "flume-solver tests/pickup.rs": 40,
-    "flume-solver tests/gpu_vs_reference.rs": 36,
+    "flume-solver tests/weir.rs": 1011,
+    "flume-solver tests/roughness.rs": 937,
+    "flume-twin tests/whole_session.rs": 875,
+    "flume-solver tests/whole_session.rs": 568,
+    "flume-solver tests/cases.rs": 320,
+    "flume-solver tests/scour.rs": 299,
+    "flume-solver tests/awake_set.rs": 271,
+    "flume-solver tests/erosion_chain.rs": 188,
+    "flume-solver tests/front_step.rs": 110,
+    "flume-solver tests/pickup.rs": 69,
+    "flume-solver tests/gpu_vs_reference.rs": 33,
+    "flume-solver tests/splash.rs": 26,
+    "flume-solver tests/pores.rs": 24,
 }
 # The node's binaries that need no machine to themselves.
 POOLED_NODE = {"flume-twin tests/whole_session.rs"}
-# Binaries whose wgpu runs of the CI flume on lavapipe grow to 8-10 GB (the process grows
-# about 22 MB/s while they run): never two of them at once on a 24 GiB machine.
+# Binaries whose wgpu runs of the CI flume grow to 8-10 GB on Debian 12's own Mesa 22.3 (its
+# lavapipe keeps memory for every rheology dispatch; the scripts install Mesa 25 where they
+# install a driver, but a machine may already have 22.3): never two of them at once.
 APART = {"flume-solver tests/whole_session.rs", "flume-solver tests/weir.rs"}
 
 
