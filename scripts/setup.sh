@@ -17,10 +17,10 @@ have_vulkan_icd() {
   return 1
 }
 
-# Debian 12's own Mesa (22.3) has a lavapipe that keeps about 32 KB for every dispatch of the
-# rheology stage, and never gives it back: a wgpu run of the CI flume grows by some 20 MB a
-# second and past 8 GB in one test. Mesa 25 from Debian's own backports does not, and runs
-# the same wgpu test about five times faster (README, "Software Vulkan").
+# Debian 12's own Mesa (22.3) has a lavapipe that keeps memory with every step of the rheology
+# pass and never gives it back: a wgpu run of the CI flume grows by 14-22 MB a second, past 8 GB
+# in one test. Mesa 25 from Debian's own backports does not, and runs the same wgpu test about
+# five times faster (README, "Software Vulkan").
 debian_codename() {
   if [ -r /etc/os-release ]; then
     (. /etc/os-release && [ "${ID:-}" = "debian" ] && echo "${VERSION_CODENAME:-}")
@@ -32,14 +32,12 @@ if ! have_vulkan_icd; then
   if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
   release=()
   if [ "$(debian_codename)" = "bookworm" ]; then
-    echo "no Vulkan driver found: installing mesa-vulkan-drivers (lavapipe, software Vulkan)" \
-      "from bookworm-backports" >&2
     echo "deb http://deb.debian.org/debian bookworm-backports main" |
       $sudo_cmd tee /etc/apt/sources.list.d/flume-twin-backports.list >/dev/null
     release=(-t bookworm-backports)
-  else
-    echo "no Vulkan driver found: installing mesa-vulkan-drivers (lavapipe, software Vulkan)" >&2
   fi
+  echo "no Vulkan driver found: installing mesa-vulkan-drivers (lavapipe, software Vulkan)" \
+    "${release[@]}" >&2
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${release[@]}" \
     mesa-vulkan-drivers >/dev/null

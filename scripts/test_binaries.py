@@ -9,9 +9,9 @@ runs at CI size on two threads about 1.2, so on two cores the second sat idle mu
 Here the binaries that only compute share a pool of one lane per core, longest first; those
 that serve DDS, WebSockets or shared memory against wall-clock deadlines (the node's, but its
 whole-session replay, which writes files) run afterwards one at a time, with the machine to
-themselves, as cargo ran them. The two binaries whose runs grow to gigabytes on Mesa 22.3's lavapipe
-(APART) never run at once. Each binary runs in its package's directory, as under `cargo
-test`. The exit status is 1 when any binary failed, 2 on bad input.
+themselves, as cargo ran them. The two binaries whose runs grow to gigabytes on Mesa 22.3's
+lavapipe (APART) never run at once. Each binary runs in its package's directory, as under
+`cargo test`. The exit status is 1 when any binary failed, 2 on bad input.
 """
 
 import json

@@ -29,6 +29,14 @@ pub fn lock_for(backend: &Backend) -> Option<MutexGuard<'static, ()>> {
     matches!(backend, Backend::Gpu(_)).then(gpu_lock)
 }
 
+/// This process's resident size in bytes, where Linux tells it (`/proc/self/statm`, in pages of
+/// 4 KiB on x86-64), to hold a run's memory to a bound.
+pub fn resident_bytes() -> Option<u64> {
+    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: u64 = statm.split_whitespace().nth(1)?.parse().ok()?;
+    Some(pages * 4096)
+}
+
 /// The backend `simulate` chooses (`Backend::choose`): `FLUME_TWIN_ADAPTER`, else a hardware
 /// GPU, else the CPU backend, which runs a flume some five times faster than lavapipe on the
 /// same cores. The physics of whole cases runs on it; the wgpu stages are held to their CPU
