@@ -12,6 +12,7 @@
 mod fixture;
 mod forces;
 mod grid;
+mod heap;
 mod multiphase;
 mod observe;
 mod simd;
@@ -134,6 +135,7 @@ impl CpuEngine {
         probe_points: &[[f32; 4]],
         shape: PipelineShape,
     ) -> Result<CpuEngine, SolverError> {
+        heap::keep_freed_memory();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|k| format!("flume-cpu-{k}"))
