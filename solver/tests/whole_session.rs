@@ -109,7 +109,7 @@ fn water_front(obs: &Observations, dp: f64) -> Option<f64> {
 
 /// Runs the CI flume to `end_s` on `backend`, checking the books every second; prints the
 /// figures.
-fn run(backend: Backend, end_s: u32) -> (Vec<Second>, f64) {
+fn run(backend: Backend, end_s: u32) -> Vec<Second> {
     let c = ulbra_ci();
     let mut sim = Simulation::new(backend, &c).expect("case builds");
     let start = sim.read_particles().expect("reads");
@@ -156,7 +156,7 @@ fn run(backend: Backend, end_s: u32) -> (Vec<Second>, f64) {
         sim.steps(),
         sim.recoveries()
     );
-    (seconds, wall)
+    seconds
 }
 
 const CPU: Backend = Backend::cpu(0);
@@ -165,7 +165,7 @@ const CPU: Backend = Backend::cpu(0);
 /// of the backends' comparison, which would otherwise run them again.
 fn cpu_18_s() -> &'static [Second] {
     static RUN: OnceLock<Vec<Second>> = OnceLock::new();
-    RUN.get_or_init(|| run(CPU, 18).0)
+    RUN.get_or_init(|| run(CPU, 18))
 }
 
 /// The bundled session's steady levels at 2 m3/h (`tests/data/ulbra_session.mcap`, made by
@@ -243,7 +243,7 @@ fn ulbra_runs_the_papers_18_s_at_ci_size() {
 #[test]
 #[ignore = "about twenty minutes on 2 cores; run on demand"]
 fn ulbra_runs_120_s_keeping_the_books() {
-    let (seconds, _) = run(CPU, 120);
+    let seconds = run(CPU, 120);
     let last = seconds.last().and_then(|s| s.obs.flume).expect("flume");
     assert_eq!(last.starved_particles, 0, "the inlet ran dry");
 }
@@ -258,7 +258,7 @@ fn ulbra_runs_120_s_keeping_the_books() {
 fn the_cpu_and_wgpu_backends_agree_on_the_ci_flume() {
     let _l = common::gpu_lock();
     let Some(gpu) = common::gpu() else { return };
-    let (wgpu, _) = run(Backend::from(gpu), 6);
+    let wgpu = run(Backend::from(gpu), 6);
     let cpu = &cpu_18_s()[..6];
     let dp = ulbra_ci().numerics.dp_m;
     let mut worst = 0.0f64;
