@@ -23,12 +23,38 @@ impl Group {
     /// Lanes whose own neighbourhood (`reach` cells each way) holds cell x `x` of a row.
     #[inline(always)]
     pub fn near(&self, x: i32, reach: i32) -> LaneMask {
-        LaneMask::from_fn(|k| (x - self.cells_x[k]).abs() <= reach)
+        near(&self.cells_x, x, reach)
     }
 
     /// The x of the group's last cell.
     pub fn last_x(&self) -> i32 {
         self.cells_x[LANES - 1]
+    }
+}
+
+/// Lanes whose cell x `cells_x` lies within `reach` cells of cell x `x`.
+#[inline(always)]
+fn near(cells_x: &[i32; LANES], x: i32, reach: i32) -> LaneMask {
+    LaneMask::from_fn(|k| (x - cells_x[k]).abs() <= reach)
+}
+
+/// Up to [`LANES`] particles of one row of cells taken together though not consecutive in
+/// the sorted order: those of a stretch of it that a pass walks, the others left out.
+pub struct Packed {
+    /// The sorted indices of the particles taken, in order; lanes past `count` repeat the
+    /// last.
+    pub members: [usize; LANES],
+    pub count: usize,
+    /// The cell of the first taken.
+    cell: [i32; 3],
+    /// The x of each one's cell, lane by lane.
+    cells_x: [i32; LANES],
+}
+
+impl Packed {
+    /// The particles taken, lane by lane.
+    pub fn taken(&self) -> &[usize] {
+        &self.members[..self.count]
     }
 }
 
@@ -195,6 +221,57 @@ impl Grid {
         }
     }
 
+    /// The particles from sorted particle `first` (up to `end`) that `take` accepts, [`LANES`]
+    /// at most, of `first`'s row of cells (same y and z) and no more than `span` cells along
+    /// it from the first taken: a group whose lanes are all walked, where [`Grid::group`]
+    /// would also carry the particles in between that a pass spares. The stretch holds at
+    /// least `first`; None where it takes nobody.
+    #[inline(always)]
+    pub fn packed(
+        &self,
+        (first, end): (usize, usize),
+        x: impl Fn(usize) -> [f32; 3],
+        take: impl Fn(usize) -> bool,
+        span: i32,
+    ) -> (Range<usize>, Option<Packed>) {
+        let row = self.coords(&x(first));
+        let mut members = [first; LANES];
+        let mut cells_x = [row[0]; LANES];
+        let mut count = 0;
+        let mut stop = first;
+        while stop < end {
+            let c = self.coords(&x(stop));
+            if c[1] != row[1] || c[2] != row[2] {
+                break;
+            }
+            if take(stop) {
+                if count == LANES || (count > 0 && c[0] - cells_x[0] > span) {
+                    break;
+                }
+                members[count] = stop;
+                cells_x[count] = c[0];
+                count += 1;
+            }
+            stop += 1;
+        }
+        // `first` lies in its own row: the stretch holds it.
+        let stretch = first..stop;
+        if count == 0 {
+            return (stretch, None);
+        }
+        let last = (members[count - 1], cells_x[count - 1]);
+        members[count..].fill(last.0);
+        cells_x[count..].fill(last.1);
+        let cell = [cells_x[0], row[1], row[2]];
+        let packed = Packed {
+            members,
+            count,
+            cell,
+            cells_x,
+        };
+        (stretch, Some(packed))
+    }
+
     /// Calls `visit` with the sorted-index range and the x of each cell within reach of any
     /// of the cells `c` to `[x_last, c[1], c[2]]` (a group's row), rows in the order of
     /// [`Grid::rows`] and cells along each row: a particle of the group visits its own
@@ -230,6 +307,18 @@ impl Grid {
             group.last_x(),
             #[inline(always)]
             |range, x| visit(range, group.near(x, reach)),
+        );
+    }
+
+    /// [`Grid::group_cells`] for a [`Packed`] group.
+    #[inline(always)]
+    pub fn packed_cells(&self, p: &Packed, mut visit: impl FnMut(Range<usize>, LaneMask)) {
+        let reach = self.reach;
+        self.row_span(
+            p.cell,
+            p.cells_x[LANES - 1],
+            #[inline(always)]
+            |range, x| visit(range, near(&p.cells_x, x, reach)),
         );
     }
 

@@ -24,7 +24,7 @@
 //! Under the water a held grain deep in the bed sleeps too, where its last walk bounds its
 //! kernel mass over the surface threshold ([`deep`]).
 
-use super::grid::{Flagged, Grid, Group};
+use super::grid::{Flagged, Grid, Packed};
 use super::simd;
 use crate::physics::Params;
 use crate::physics::interaction::phase_index;
@@ -292,6 +292,10 @@ const NONE_PASSED: (f32, u32) = (0.0, NO_TARGET);
 /// Particles per block handed to a thread, as in the force pass.
 const BLOCK: usize = 64;
 
+/// How far along its row of cells a packed group of the rheology's walk may reach from its
+/// first particle, cells: a wider group walks more cells for each of its lanes.
+const PACKED_SPAN: i32 = 4;
+
 /// What the rheology's neighbour loop reads.
 struct Pairs<'a> {
     params: &'a Params,
@@ -323,41 +327,44 @@ struct Pairs<'a> {
 
 impl Pairs<'_> {
     /// The rheology of the particles from `first` into `out`, in groups of one row of cells
-    /// as the force pass takes them: each lane sums its own neighbours in sorted order.
+    /// as the force pass takes them, but packed: the particles a group would walk, the ones
+    /// spared left out ([`Grid::packed`]); each lane sums its own neighbours in sorted order.
     /// Returns how many were spared the walk over their neighbours. With [`deep`]'s rule each
     /// particle's record goes to `records`: a sleeper keeps its own.
     #[inline(always)]
     fn block(&self, first: usize, out: &mut [ParticleRheology], records: &mut [f32]) -> usize {
         let mut asleep = 0;
-        let (pass, grid, pos, vel) = (self.pass, self.grid, self.pos, self.vel);
+        let (pass, pos, vel) = (self.pass, self.pos, self.vel);
         let end = first + out.len();
         let mut start = first;
+        // A sleeper's sums give it what its start does, and a wall's rheology is none
+        // whatever its neighbours.
+        let spared = |i: usize| self.asleep[i] || !self.params.phases[phase_index(&pos[i])].mobile;
         while start < end {
-            let group = grid.group(start, end, |k| self.sides[k].x);
-            // A group with an awake grain or a moving particle is walked whole: a sleeper's
-            // sums give it what its start does, and a wall's rheology is none whatever its
-            // neighbours.
-            let spared =
-                |i: usize| self.asleep[i] || !self.params.phases[phase_index(&pos[i])].mobile;
-            if group.range.clone().all(spared) {
-                asleep += group.range.len();
-                for i in group.range.clone() {
-                    let id = self.ids[i] as usize;
-                    records[i - first] = self.records.get(id).copied().unwrap_or(NO_RECORD);
-                    let s = pass.start(&pos[i], &vel[i]);
-                    let before = (self.words[i], self.ids[i]);
-                    let r = &mut out[i - first];
-                    *r = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
-                    // At rest under no water a grain at the top passes on nothing, and
-                    // offers to take what a wet front brings.
-                    let top = |t: &[u8]| t[self.ids[i] as usize] == BED_TOP;
-                    if self.asleep[i] && self.bed_tops.is_some_and(top) {
-                        r.flux = 0.0;
-                    }
+            let (stretch, packed) = self.grid.packed(
+                (start, end),
+                |k| self.sides[k].x,
+                |k| !spared(k),
+                PACKED_SPAN,
+            );
+            for i in stretch.clone().filter(|&i| spared(i)) {
+                asleep += 1;
+                let id = self.ids[i] as usize;
+                records[i - first] = self.records.get(id).copied().unwrap_or(NO_RECORD);
+                let s = pass.start(&pos[i], &vel[i]);
+                let before = (self.words[i], self.ids[i]);
+                let r = &mut out[i - first];
+                *r = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
+                // At rest under no water a grain at the top passes on nothing, and offers to
+                // take what a wet front brings.
+                let top = |t: &[u8]| t[id] == BED_TOP;
+                if self.asleep[i] && self.bed_tops.is_some_and(top) {
+                    r.flux = 0.0;
                 }
-            } else {
-                let sums = self.group(&group);
-                for (lane, i) in group.range.clone().enumerate() {
+            }
+            if let Some(packed) = packed {
+                let sums = self.group(&packed);
+                for (lane, &i) in packed.taken().iter().enumerate() {
                     let s = sums.lane(lane);
                     if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
                         records[i - first] = d.record(s.kernel_mass());
@@ -367,7 +374,7 @@ impl Pairs<'_> {
                     out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, exchange);
                 }
             }
-            start = group.range.end;
+            start = stretch.end;
         }
         asleep
     }
@@ -396,19 +403,18 @@ impl Pairs<'_> {
         (passed, ex.outcome().1)
     }
 
-    /// The sums of `group`, from each particle's own start.
+    /// The sums of the particles `packed` takes, from each one's own start.
     #[inline(always)]
-    fn group(&self, group: &Group) -> RheologySums<Lanes> {
-        let (pass, grid, pos, vel) = (self.pass, self.grid, self.pos, self.vel);
-        let range = group.range.clone();
-        let starts: [RheologySums; LANES] = std::array::from_fn(|k| {
-            let i = (range.start + k).min(range.end - 1);
-            pass.start(&pos[i], &vel[i])
-        });
+    fn group(&self, packed: &Packed) -> RheologySums<Lanes> {
+        let (pass, pos, vel) = (self.pass, self.pos, self.vel);
+        let m = packed.members;
+        let starts: [RheologySums; LANES] =
+            std::array::from_fn(|k| pass.start(&pos[m[k]], &vel[m[k]]));
         let mut sums = RheologySums::lanes(&starts);
-        let side = RheologySide::lanes(&self.sides[range]);
-        grid.group_cells(
-            group,
+        let sides: [RheologySide; LANES] = std::array::from_fn(|k| self.sides[m[k]]);
+        let side = RheologySide::lanes(&sides);
+        self.grid.packed_cells(
+            packed,
             #[inline(always)]
             |range, near| {
                 for j in range {
