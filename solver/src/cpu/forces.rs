@@ -2,8 +2,9 @@
 //! (`PairModel::add_pair`, the one statement of the formulas) over the contiguous rows of the
 //! cell list, particles shared out among threads in blocks. A block is taken in groups of up
 //! to [`LANES`] particles of one row of cells, each neighbour against the whole group at once
-//! (`physics::lanes`); every lane sums its own neighbours in sorted order, as one particle
-//! alone would, so the result does not depend on the grouping or on the number of threads.
+//! (`physics::lanes`), a group packed with the particles that walk alone (`Grid::group`);
+//! every lane sums its own neighbours in sorted order, as one particle alone would, so the
+//! result does not depend on the grouping or on the number of threads.
 //!
 //! The awake set: a wall (or held sand standing as one) takes no acceleration, so its only
 //! output is its density. Under the generalised condition that comes from its wall sums over
@@ -19,7 +20,7 @@ use super::grid::{Flagged, Grid, Group};
 use super::simd;
 use crate::physics::boundary::WallSums;
 use crate::physics::interaction::{PairModel, PairSum, Side};
-use crate::physics::lanes::{LANES, LaneMask, Lanes, Mask, Real};
+use crate::physics::lanes::{LANES, Lanes, Real};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::particle_viscous_bound;
 use rayon::prelude::*;
@@ -120,101 +121,135 @@ pub fn force_pass(
 }
 
 impl Pass<'_> {
-    /// The particles of one block, from sorted index `first`, group by group; returns how
-    /// many walls were spared the walk over their neighbours.
+    /// The particles from sorted index `first`, [`BLOCK`] at a time ([`Pass::chunk`]);
+    /// returns how many walls were spared the walk over their neighbours.
     #[inline(always)]
     fn block(&self, first: usize, forces: &mut [[f32; 4]], dt_limit: &mut [f32]) -> usize {
-        let end = first + forces.len();
-        let mut start = first;
+        let chunks = forces.chunks_mut(BLOCK).zip(dt_limit.chunks_mut(BLOCK));
         let mut asleep = 0;
-        while start < end {
-            let group = self.grid.group(start, end, |k| self.sides[k].x);
-            let range = group.range.clone();
-            let (wet, spared) = self.walls_of(&group);
-            // A group of walls that need no pair sums is not walked at all; in a group
-            // with others, their lanes' sums are left unread.
-            let walk = !spared[..range.len()].iter().all(|s| *s);
-            // Not `walk.then(|| ..)`: a closure LLVM keeps apart runs without AVX2
-            // (`super::simd`).
-            let sums = if walk { Some(self.group(&group)) } else { None };
-            asleep += if walk { 0 } else { range.len() };
-            let walls = self.wall_sums(&group, &wet);
-            for (lane, i) in range.enumerate() {
-                let mut s = PairSum::default();
-                if let Some((sum, tau)) = sums.as_ref().filter(|_| !spared[lane]) {
-                    s = sum.lane(lane);
-                    for (a, t) in s.acc.iter_mut().zip(tau) {
-                        *a += t.0[lane];
-                    }
-                }
-                let wall = walls.as_ref().map(|w| w.lane(lane));
-                (forces[i - first], dt_limit[i - first]) = self.finish(i, &s, wall.as_ref());
-            }
-            start = group.range.end;
+        for (k, (forces, dt_limit)) in chunks.enumerate() {
+            asleep += self.chunk(first + k * BLOCK, forces, dt_limit);
         }
         asleep
     }
 
+    /// The particles of at most [`BLOCK`] from sorted index `first`: the pair sums of those
+    /// that walk their neighbours, in groups of one row of cells packed with them alone
+    /// ([`Grid::group`]), then the wall sums of the wet walls packed the same way, then each
+    /// particle's forces; returns how many walls were spared the walk over their neighbours.
+    #[inline(always)]
+    fn chunk(&self, first: usize, forces: &mut [[f32; 4]], dt_limit: &mut [f32]) -> usize {
+        let end = first + forces.len();
+        let mut wet = [true; BLOCK];
+        let mut spared = [false; BLOCK];
+        for i in first..end {
+            (wet[i - first], spared[i - first]) = self.wall_of(i);
+        }
+        let mut sums = [PairSum::default(); BLOCK];
+        self.groups(
+            (first, end),
+            |k| !spared[k - first],
+            #[inline(always)]
+            |group| {
+                let (sum, tau) = self.group(group);
+                for (lane, &i) in group.taken().iter().enumerate() {
+                    let s = &mut sums[i - first];
+                    *s = sum.lane(lane);
+                    for (a, t) in s.acc.iter_mut().zip(&tau) {
+                        *a += t.0[lane];
+                    }
+                }
+            },
+        );
+        let mut walls = [None; BLOCK];
+        if self.model.params().generalised_walls {
+            self.groups(
+                (first, end),
+                |k| wet[k - first] && !self.sides[k].mobile,
+                #[inline(always)]
+                |group| {
+                    let sums = self.wall_sums(group);
+                    for (lane, &i) in group.taken().iter().enumerate() {
+                        walls[i - first] = Some(sums.lane(lane));
+                    }
+                },
+            );
+        }
+        for i in first..end {
+            let k = i - first;
+            (forces[k], dt_limit[k]) = self.finish(i, &sums[k], walls[k].as_ref());
+        }
+        spared[..end - first].iter().filter(|s| **s).count()
+    }
+
+    /// Calls `walk` with each group of the particles from `first` to `end` that `take`
+    /// accepts, in sorted order.
+    #[inline(always)]
+    fn groups(
+        &self,
+        (first, end): (usize, usize),
+        take: impl Fn(usize) -> bool,
+        mut walk: impl FnMut(&Group),
+    ) {
+        let mut start = first;
+        while start < end {
+            let (stretch, group) = self.grid.group((start, end), |k| self.sides[k].x, &take);
+            if let Some(group) = group {
+                walk(&group);
+            }
+            start = stretch.end;
+        }
+    }
+
     /// The lane-pairs the walks of the particles from `first` to `end` evaluate, and those
     /// within the kernel's support for a lane whose sums are read and a pair that adds
-    /// something (not two walls): what [`Pass::block`] walks, counted.
+    /// something (not two walls): what [`Pass::block`]'s pair sums walk, counted.
     fn census(&self, first: usize, end: usize) -> LaneUse {
         let support2 = (2.0 * self.model.params().h).powi(2);
         let mut count = LaneUse::default();
-        let mut start = first;
-        while start < end {
-            let group = self.grid.group(start, end, |k| self.sides[k].x);
-            let range = group.range.clone();
-            let (_, spared) = self.walls_of(&group);
-            if !spared[..range.len()].iter().all(|s| *s) {
-                self.grid.row_span(group.cell, group.last_x(), |cands, _| {
-                    count.evaluated += (cands.len() * LANES) as u64;
-                    for j in cands {
-                        let (b, x_j) = (&self.sides[j], self.sides[j].x);
-                        for (lane, i) in range.clone().enumerate() {
-                            let a = &self.sides[i];
-                            let r2: f32 = (0..3).map(|k| (a.x[k] - x_j[k]).powi(2)).sum();
-                            let adds = a.mobile || b.mobile;
-                            let useful = !spared[lane] && adds && i != j && r2 < support2;
-                            count.useful += u64::from(useful);
-                        }
+        let walks = |k: usize| !self.wall_of(k).1;
+        self.groups((first, end), walks, |group| {
+            self.grid.group_cells(group, |cands, _| {
+                count.evaluated += (cands.len() * LANES) as u64;
+                for j in cands {
+                    let (b, x_j) = (&self.sides[j], self.sides[j].x);
+                    for &i in group.taken() {
+                        let a = &self.sides[i];
+                        let r2: f32 = (0..3).map(|k| (a.x[k] - x_j[k]).powi(2)).sum();
+                        let adds = a.mobile || b.mobile;
+                        count.useful += u64::from(adds && i != j && r2 < support2);
                     }
-                });
-            }
-            start = range.end;
-        }
+                }
+            });
+        });
         count
     }
 
-    /// For each lane of `group`: whether a mobile particle is in reach (always, for a mobile
-    /// particle or without the awake set), and whether it is a wall whose pair sums nothing
-    /// reads (see the module doc).
+    /// Whether a mobile particle is in reach of particle `i` (always, for a mobile particle
+    /// or without the awake set), and whether it is a wall whose pair sums nothing reads (see
+    /// the module doc).
     #[inline(always)]
-    fn walls_of(&self, group: &Group) -> ([bool; LANES], [bool; LANES]) {
-        let (mut wet, mut spared) = ([true; LANES], [false; LANES]);
-        let Some(mobile) = self.extra.mobile else {
-            return (wet, spared);
-        };
-        let generalised = self.model.params().generalised_walls;
-        for (lane, i) in group.range.clone().enumerate() {
-            let side = &self.sides[i];
-            if !side.mobile {
-                wet[lane] = self.grid.any_near(mobile, &side.x);
-                spared[lane] = generalised || !wet[lane];
+    fn wall_of(&self, i: usize) -> (bool, bool) {
+        let side = &self.sides[i];
+        match self.extra.mobile {
+            Some(mobile) if !side.mobile => {
+                let wet = self.grid.any_near(mobile, &side.x);
+                (wet, self.model.params().generalised_walls || !wet)
             }
+            _ => (true, false),
         }
-        (wet, spared)
     }
 
     /// The pair sums of `group` and, with the multiphase model, its stress divergence.
     #[inline(always)]
     fn group(&self, group: &Group) -> (PairSum<Lanes>, [Lanes; 3]) {
         let (grid, model, sides) = (self.grid, self.model, self.sides);
-        let side = Side::lanes(&sides[group.range.clone()]);
+        let m = &group.members;
+        let side = Side::lanes(&m.map(|i| sides[i]));
         let mut sum = PairSum::<Lanes>::default();
         let mut tau = [Lanes::splat(0.0); 3];
         let stress = self.extra.stress.map(|(div, stress, _)| {
-            let mine = StressSide::lanes(&stress[group.range.clone()]);
+            let mine = StressSide::lanes(&m.map(|i| stress[i]));
             (div, stress, mine)
         });
         grid.group_cells(
@@ -238,24 +273,12 @@ impl Pass<'_> {
         (sum, tau)
     }
 
-    /// The generalised wall sums (`physics::boundary`) of the walls of `group` that have a
-    /// mobile particle within reach (`wet`), each lane over its own neighbours in sorted
-    /// order, as one wall alone would; None when the group has no such wall. The other lanes'
-    /// sums stay empty: a dry wall takes rest density.
+    /// The generalised wall sums (`physics::boundary`) of a group of wet walls, each lane
+    /// over its own neighbours in sorted order, as one wall alone would. A dry wall takes
+    /// rest density without them.
     #[inline(always)]
-    fn wall_sums(&self, group: &Group, wet: &[bool; LANES]) -> Option<WallSums<Lanes>> {
-        if !self.model.params().generalised_walls {
-            return None;
-        }
-        let range = group.range.clone();
-        let walls = LaneMask::from_fn(|k| {
-            let i = range.start + k;
-            k < range.len() && wet[k] && !self.sides[i].mobile
-        });
-        if !walls.any() {
-            return None;
-        }
-        let side = Side::lanes(&self.sides[range]);
+    fn wall_sums(&self, group: &Group) -> WallSums<Lanes> {
+        let side = Side::lanes(&group.members.map(|i| self.sides[i]));
         let mut sums = WallSums::<Lanes>::default();
         self.grid.group_cells(
             group,
@@ -263,11 +286,11 @@ impl Pass<'_> {
             |range, near| {
                 for j in range {
                     self.model
-                        .add_wall_pair(&side, &self.sides[j], near & walls, &mut sums);
+                        .add_wall_pair(&side, &self.sides[j], near, &mut sums);
                 }
             },
         );
-        Some(sums)
+        sums
     }
 
     /// Particle `i`'s forces and step from its sums, and a wall's density from its `wall`

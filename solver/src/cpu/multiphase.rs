@@ -24,7 +24,7 @@
 //! Under the water a held grain deep in the bed sleeps too, where its last walk bounds its
 //! kernel mass over the surface threshold ([`deep`]).
 
-use super::grid::{Flagged, Grid, Packed};
+use super::grid::{Flagged, Grid, Group};
 use super::simd;
 use crate::physics::Params;
 use crate::physics::interaction::phase_index;
@@ -292,10 +292,6 @@ const NONE_PASSED: (f32, u32) = (0.0, NO_TARGET);
 /// Particles per block handed to a thread, as in the force pass.
 const BLOCK: usize = 64;
 
-/// How far along its row of cells a packed group of the rheology's walk may reach from its
-/// first particle, cells: a wider group walks more cells for each of its lanes.
-const PACKED_SPAN: i32 = 4;
-
 /// What the rheology's neighbour loop reads.
 struct Pairs<'a> {
     params: &'a Params,
@@ -327,8 +323,8 @@ struct Pairs<'a> {
 
 impl Pairs<'_> {
     /// The rheology of the particles from `first` into `out`, in groups of one row of cells
-    /// as the force pass takes them, but packed: the particles a group would walk, the ones
-    /// spared left out ([`Grid::packed`]); each lane sums its own neighbours in sorted order.
+    /// as the force pass takes them, the particles it spares left out of them
+    /// ([`Grid::group`]); each lane sums its own neighbours in sorted order.
     /// Returns how many were spared the walk over their neighbours. With [`deep`]'s rule each
     /// particle's record goes to `records`: a sleeper keeps its own.
     #[inline(always)]
@@ -341,12 +337,9 @@ impl Pairs<'_> {
         // whatever its neighbours.
         let spared = |i: usize| self.asleep[i] || !self.params.phases[phase_index(&pos[i])].mobile;
         while start < end {
-            let (stretch, packed) = self.grid.packed(
-                (start, end),
-                |k| self.sides[k].x,
-                |k| !spared(k),
-                PACKED_SPAN,
-            );
+            let (stretch, group) =
+                self.grid
+                    .group((start, end), |k| self.sides[k].x, |k| !spared(k));
             for i in stretch.clone().filter(|&i| spared(i)) {
                 asleep += 1;
                 let id = self.ids[i] as usize;
@@ -362,9 +355,9 @@ impl Pairs<'_> {
                     r.flux = 0.0;
                 }
             }
-            if let Some(packed) = packed {
-                let sums = self.group(&packed);
-                for (lane, &i) in packed.taken().iter().enumerate() {
+            if let Some(group) = group {
+                let sums = self.group(&group);
+                for (lane, &i) in group.taken().iter().enumerate() {
                     let s = sums.lane(lane);
                     if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
                         records[i - first] = d.record(s.kernel_mass());
@@ -403,18 +396,18 @@ impl Pairs<'_> {
         (passed, ex.outcome().1)
     }
 
-    /// The sums of the particles `packed` takes, from each one's own start.
+    /// The sums of the particles `group` takes, from each one's own start.
     #[inline(always)]
-    fn group(&self, packed: &Packed) -> RheologySums<Lanes> {
+    fn group(&self, group: &Group) -> RheologySums<Lanes> {
         let (pass, pos, vel) = (self.pass, self.pos, self.vel);
-        let m = packed.members;
+        let m = group.members;
         let starts: [RheologySums; LANES] =
             std::array::from_fn(|k| pass.start(&pos[m[k]], &vel[m[k]]));
         let mut sums = RheologySums::lanes(&starts);
         let sides: [RheologySide; LANES] = std::array::from_fn(|k| self.sides[m[k]]);
         let side = RheologySide::lanes(&sides);
-        self.grid.packed_cells(
-            packed,
+        self.grid.group_cells(
+            group,
             #[inline(always)]
             |range, near| {
                 for j in range {
