@@ -457,7 +457,7 @@ mod tests {
                 let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
                 force_pass(&pool, &model, &fx.grid, &sides, extra, &mut f, &mut dt);
                 assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");
-                // The baseline copy, without the AVX2 one, and the whole as one block.
+                // The baseline copy, without the AVX2 one, and the whole in one call.
                 let (mut f, mut dt) = (vec![[0.0; 4]; n], vec![0.0; n]);
                 pass(extra).block(0, &mut f, &mut dt);
                 assert!(bits(&f, &dt) == bits(&want_f, &want_dt), "{viscosity:?}");

@@ -36,9 +36,9 @@ impl Group {
     }
 }
 
-/// How far along its row of cells a group may reach, cells: a wider
-/// group walks more cells for each of its lanes. On the CI flume's rheology pass 4 ran 12 %
-/// faster than groups of consecutive particles, 2 about as fast, 8 slower.
+/// How far along its row of cells a group may reach, cells: a wider group walks more cells
+/// for each of its lanes. On the CI twin 4 ran fastest, 2 about as fast, 8 slower (README,
+/// speed: "Groups packed with the particles that walk").
 const GROUP_SPAN: i32 = 4;
 
 pub struct Grid {
@@ -329,16 +329,22 @@ mod tests {
         })
     }
 
-    /// Every particle inside a box lies in a row `rows_in_box` visits, for boxes from a tenth
-    /// of a cell to three cells wide anywhere on the grid, across cell edges and its border.
-    #[test]
-    fn a_box_s_rows_hold_every_particle_in_it() {
+    /// A 2-D grid of 12 x 9 cells of h = 1.7 dp at dp = 0.01 (two divisions of 2h, as the
+    /// CI flume has), and its cell size.
+    fn twelve_by_nine() -> (Grid, f32) {
         let mut sim = SimParams::zeroed();
         let cell = 0.017;
         sim.grid_dims = [12, 9, 1, 0];
         sim.grid_origin = [0.0, 0.0, 0.0, 1.0 / cell];
         sim.n_cells = 12 * 9;
-        let mut grid = Grid::new(&sim, 2);
+        (Grid::new(&sim, 2), cell)
+    }
+
+    /// Every particle inside a box lies in a row `rows_in_box` visits, for boxes from a tenth
+    /// of a cell to three cells wide anywhere on the grid, across cell edges and its border.
+    #[test]
+    fn a_box_s_rows_hold_every_particle_in_it() {
+        let (mut grid, cell) = twelve_by_nine();
         // A lattice of dp = 0.01 shaken by up to 0.4 dp, some of it outside the grid.
         let mut seed = 11u32;
         let mut shake = || {
@@ -380,12 +386,7 @@ mod tests {
     /// order, and whichever particles the group leaves out.
     #[test]
     fn each_member_of_a_group_walks_its_own_neighbours_in_order() {
-        let mut sim = SimParams::zeroed();
-        let cell = 0.017;
-        sim.grid_dims = [12, 9, 1, 0];
-        sim.grid_origin = [0.0, 0.0, 0.0, 1.0 / cell];
-        sim.n_cells = 12 * 9;
-        let mut grid = Grid::new(&sim, 2);
+        let (mut grid, cell) = twelve_by_nine();
         let mut pos = Vec::new();
         for iy in 0..14 {
             for ix in 0..19 {
