@@ -11,11 +11,14 @@ that serve DDS, WebSockets or shared memory against wall-clock deadlines (the no
 whole-session replay, which writes files) run afterwards one at a time, with the machine to
 themselves, as cargo ran them. The two binaries whose runs grow to gigabytes on Mesa 22.3's
 lavapipe (APART) never run at once. Each binary runs in its package's directory, as under
-`cargo test`. The exit status is 1 when any binary failed, 2 on bad input.
+`cargo test`. The exit status is 1 when any binary failed, 2 on bad input, 130 when
+interrupted (Ctrl-C or SIGTERM): each binary runs in a process group of its own, which is
+killed whole, with whatever it started, and no binary starts after the interrupt.
 """
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -45,6 +48,44 @@ POOLED_NODE = {"flume-twin tests/whole_session.rs"}
 # lavapipe keeps memory for every rheology dispatch; the scripts install Mesa 25 where they
 # install a driver, but a machine may already have 22.3): never two of them at once.
 APART = {"flume-solver tests/whole_session.rs", "flume-solver tests/weir.rs"}
+
+
+class Interrupted(Exception):
+    pass
+
+
+class Children:
+    """The process groups of the binaries running now, killed whole on an interrupt; after
+    it, nothing more starts."""
+
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.groups = set()
+        self.stopped = False
+
+    def start(self, argv, **kwargs):
+        with self.lock:
+            if self.stopped:
+                raise Interrupted()
+            child = subprocess.Popen(argv, start_new_session=True, **kwargs)
+            self.groups.add(child.pid)
+            return child
+
+    def ended(self, child):
+        with self.lock:
+            self.groups.discard(child.pid)
+
+    def stop(self):
+        with self.lock:
+            self.stopped = True
+            for group in self.groups:
+                try:
+                    os.killpg(group, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+
+
+CHILDREN = Children()
 
 
 class Binary:
@@ -95,7 +136,7 @@ def run(binary, args):
     with tempfile.TemporaryFile() as out:
         started = time.monotonic()
         try:
-            child = subprocess.Popen(
+            child = CHILDREN.start(
                 [binary.executable, *args],
                 cwd=binary.directory,
                 stdout=out,
@@ -103,7 +144,10 @@ def run(binary, args):
             )
         except OSError as e:
             return 127, f"cannot run {binary.executable}: {e}\n", 0.0, 0.0, 0.0
-        _, status, usage = os.wait4(child.pid, 0)
+        try:
+            _, status, usage = os.wait4(child.pid, 0)
+        finally:
+            CHILDREN.ended(child)
         child.returncode = os.waitstatus_to_exitcode(status)
         wall = time.monotonic() - started
         out.seek(0)
@@ -162,6 +206,8 @@ def run_pool(binaries, args, lanes, report):
         while (b := take()) is not None:
             try:
                 report.ended(b, *run(b, args))
+            except Interrupted:
+                return
             finally:
                 with changed:
                     apart_running &= b.label not in APART
@@ -172,6 +218,10 @@ def run_pool(binaries, args, lanes, report):
         t.start()
     for t in threads:
         t.join()
+
+
+def interrupt(signum, frame):
+    raise KeyboardInterrupt()
 
 
 def main(argv):
@@ -191,8 +241,14 @@ def main(argv):
         return 2
     report = Report()
     started = time.monotonic()
-    run_pool([b for b in binaries if not b.quiet()], args, lanes, report)
-    run_pool([b for b in binaries if b.quiet()], args, 1, report)
+    signal.signal(signal.SIGTERM, interrupt)
+    try:
+        run_pool([b for b in binaries if not b.quiet()], args, lanes, report)
+        run_pool([b for b in binaries if b.quiet()], args, 1, report)
+    except KeyboardInterrupt:
+        CHILDREN.stop()
+        print("test_binaries.py: interrupted; the running binaries were killed", flush=True)
+        return 130
     report.table()
     cpu = sum(t[1] for t in report.times)
     wall = time.monotonic() - started

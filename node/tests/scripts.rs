@@ -4,6 +4,7 @@ mod common;
 
 use common::repo_file;
 use std::process::Command;
+use std::time::{Duration, Instant};
 
 /// `water_front.py` on two runs' bed profiles: the front is the furthest column with water at
 /// least 4 mm over the sand, or over the bed's first top where a column holds no sand (the
@@ -367,5 +368,81 @@ fn the_test_runner_reports_each_binary_and_fails_when_one_fails() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("artifacts.json:2"), "{err}");
     assert!(String::from_utf8_lossy(&out.stdout).is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `test_binaries.py` stopped by SIGTERM (as a CI timeout or Ctrl-C stops it): the binary that
+/// runs is killed with what it started (a `sleep` it left behind would outlive it), no binary
+/// starts after, and the runner says so with status 130.
+#[test]
+fn the_test_runner_stops_its_binaries_and_their_children_when_stopped() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = std::env::temp_dir().join(format!("flume-runner-stop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let (pid_file, later) = (dir.join("grandchild"), dir.join("later-ran"));
+    for (name, body) in [
+        (
+            "long",
+            format!("sleep 60 & echo $! > {}; wait", pid_file.display()),
+        ),
+        ("later", format!("touch {}", later.display())),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, format!("#!/bin/sh\n{body}\n")).expect("script");
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+    }
+    let artifacts = dir.join("artifacts.json");
+    let lines = [
+        test_artifact(&dir, "fake", "long", "long.rs"),
+        test_artifact(&dir, "fake", "later", "later.rs"),
+    ];
+    std::fs::write(&artifacts, lines.join("\n")).expect("artifacts");
+    let mut runner = Command::new("python3")
+        .arg(repo_file("scripts/test_binaries.py"))
+        .arg(&artifacts)
+        .env("TEST_LANES", "1")
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("python3 runs");
+    let started = Instant::now();
+    let grandchild = loop {
+        let pid = std::fs::read_to_string(&pid_file).unwrap_or_default();
+        if let Ok(pid) = pid.trim().parse::<u32>() {
+            break pid;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "the long binary never ran"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let term = Command::new("kill")
+        .args(["-TERM", &runner.id().to_string()])
+        .status();
+    assert!(term.expect("kill runs").success());
+    let out = runner.wait_with_output().expect("the runner ends");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert_eq!(out.status.code(), Some(130), "{text}");
+    assert!(text.contains("interrupted"), "{text}");
+    // A killed process may stand a moment as a zombie before its new parent reaps it.
+    let alive = |pid: u32| {
+        std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|s| {
+            s.rsplit(')')
+                .next()
+                .is_some_and(|r| !r.trim().starts_with('Z'))
+        })
+    };
+    let gone = (0..100).any(|_| {
+        std::thread::sleep(Duration::from_millis(50));
+        !alive(grandchild)
+    });
+    assert!(
+        gone,
+        "the long binary's sleep {grandchild} outlived the runner"
+    );
+    assert!(
+        !later.exists(),
+        "a binary started after the runner was stopped"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
