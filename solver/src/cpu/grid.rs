@@ -85,7 +85,8 @@ impl Grid {
 
     /// Sorts particles by (cell, id): returns, for each sorted slot, the storage index of its
     /// particle, and fills `starts`. Particles of phase `parked` (an open flume's reservoir)
-    /// go after all cells, in storage order: no neighbour loop visits them.
+    /// go after all cells, in storage order: no neighbour loop visits them. The ids are
+    /// distinct.
     pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32], parked: Option<u32>) -> Vec<u32> {
         let outside = self.starts.len() as u32 - 1;
         let cells: Vec<u32> = positions
@@ -106,33 +107,25 @@ impl Grid {
         for c in 1..self.starts.len() {
             self.starts[c] += self.starts[c - 1];
         }
+        // A counting sort taken in id order leaves each cell in id order: no cell is sorted
+        // afterwards, and no parallel region woken for it.
+        let mut by_id = vec![u32::MAX; ids.iter().max().map_or(0, |&m| m as usize + 1)];
+        for (i, &id) in ids.iter().enumerate() {
+            by_id[id as usize] = i as u32;
+        }
         let mut cursor = self.starts.clone();
         let mut order = vec![0u32; positions.len()];
-        let mut tail = self.active();
-        for (i, &c) in cells.iter().enumerate() {
-            let slot = if c == outside {
-                tail += 1;
-                tail - 1
-            } else {
+        for &i in by_id.iter().filter(|&&i| i != u32::MAX) {
+            let c = cells[i as usize];
+            if c != outside {
+                order[cursor[c as usize] as usize] = i;
                 cursor[c as usize] += 1;
-                cursor[c as usize] - 1
-            };
-            order[slot as usize] = i as u32;
-        }
-        // Each cell's slots apart, so the cells sort on any thread; the result is the same.
-        let mut cells: Vec<&mut [u32]> = Vec::new();
-        let mut rest = &mut order[..self.active() as usize];
-        for w in self.starts.windows(2) {
-            let (cell, after) = rest.split_at_mut((w[1] - w[0]) as usize);
-            if cell.len() > 1 {
-                cells.push(cell);
             }
-            rest = after;
         }
-        cells
-            .into_par_iter()
-            .with_min_len(PAR_MIN / 8)
-            .for_each(|cell| cell.sort_unstable_by_key(|&i| ids[i as usize]));
+        let parked = (0..positions.len()).filter(|&i| cells[i] == outside);
+        for (slot, i) in (self.active() as usize..).zip(parked) {
+            order[slot] = i as u32;
+        }
         order
     }
 
@@ -303,11 +296,22 @@ impl Flagged {
 }
 
 /// `values` in sorted order: slot k holds the value of storage index `order[k]`.
+#[cfg(test)]
 pub fn gather<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
+    gather_with(order, |i| values[i])
+}
+
+/// What `value` gives of each storage index, in sorted order, unzipped: slot k of each
+/// collection holds what `value(order[k])` gave.
+pub fn gather_with<T, C>(order: &[u32], value: impl Fn(usize) -> T + Send + Sync) -> C
+where
+    T: Send,
+    C: FromParallelIterator<T>,
+{
     order
         .par_iter()
         .with_min_len(PAR_MIN)
-        .map(|&i| values[i as usize])
+        .map(|&i| value(i as usize))
         .collect()
 }
 
@@ -338,6 +342,33 @@ mod tests {
         sim.grid_origin = [0.0, 0.0, 0.0, 1.0 / cell];
         sim.n_cells = 12 * 9;
         (Grid::new(&sim, 2), cell)
+    }
+
+    /// The sort leaves each cell's particles in id order whatever their storage order, and
+    /// the parked ones after every cell in storage order (an inlet takes them in that order).
+    #[test]
+    fn the_sort_orders_each_cell_by_id_and_keeps_the_parked_in_storage_order() {
+        let (mut grid, cell) = twelve_by_nine();
+        // A particle's fourth component holds its phase's index as bits.
+        let (water, parked) = (f32::from_bits(0), 7);
+        let parked_bits = f32::from_bits(parked);
+        let at = |cx: f32, phase: f32| [(cx + 0.5) * cell, 0.5 * cell, 0.0, phase];
+        // Storage order: cells 2, 0, 2, parked, 0, parked, 2; ids not in that order.
+        let positions = [
+            at(2.0, water),
+            at(0.0, water),
+            at(2.0, water),
+            at(5.0, parked_bits),
+            at(0.0, water),
+            at(1.0, parked_bits),
+            at(2.0, water),
+        ];
+        let ids = [6, 4, 1, 0, 2, 5, 3];
+        let order = grid.sort(&positions, &ids, Some(parked));
+        // Cell 0: ids 4, 2 (slots 1, 4) -> 2 then 4; cell 2: ids 6, 1, 3 -> 1, 3, 6; then
+        // the parked slots 3 and 5 as stored.
+        assert_eq!(order, [4, 1, 2, 6, 0, 3, 5]);
+        assert_eq!(grid.active(), 5);
     }
 
     /// Every particle inside a box lies in a row `rows_in_box` visits, for boxes from a tenth

@@ -69,12 +69,18 @@ struct Snapshot {
 }
 
 impl State {
+    /// The state in sorted order: slot k holds storage index `order[k]`'s particle. One
+    /// parallel region for the four arrays, not four: each wakes the pool's threads.
     fn gather(&self, order: &[u32]) -> State {
+        let ((positions, vel_rho), (ids, vel_rho_prev)) = grid::gather_with(order, |i| {
+            let motion = (self.positions[i], self.vel_rho[i]);
+            (motion, (self.ids[i], self.vel_rho_prev[i]))
+        });
         State {
-            positions: grid::gather(&self.positions, order),
-            vel_rho: grid::gather(&self.vel_rho, order),
-            ids: grid::gather(&self.ids, order),
-            vel_rho_prev: grid::gather(&self.vel_rho_prev, order),
+            positions,
+            vel_rho,
+            ids,
+            vel_rho_prev,
         }
     }
 }
