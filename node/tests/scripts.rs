@@ -397,7 +397,7 @@ fn the_test_runner_stops_its_binaries_and_their_children_when_stopped() {
         test_artifact(&dir, "fake", "later", "later.rs"),
     ];
     std::fs::write(&artifacts, lines.join("\n")).expect("artifacts");
-    let mut runner = Command::new("python3")
+    let runner = Command::new("python3")
         .arg(repo_file("scripts/test_binaries.py"))
         .arg(&artifacts)
         .env("TEST_LANES", "1")
