@@ -115,13 +115,17 @@ impl Grid {
         }
         let mut cursor = self.starts.clone();
         let mut order = vec![0u32; positions.len()];
+        let mut placed = 0;
         for &i in by_id.iter().filter(|&&i| i != u32::MAX) {
             let c = cells[i as usize];
             if c != outside {
                 order[cursor[c as usize] as usize] = i;
                 cursor[c as usize] += 1;
+                placed += 1;
             }
         }
+        // Two particles of one id would leave a slot of the order unwritten, silently.
+        assert_eq!(placed, self.active(), "particle ids are not distinct");
         let parked = (0..positions.len()).filter(|&i| cells[i] == outside);
         for (slot, i) in (self.active() as usize..).zip(parked) {
             order[slot] = i as u32;
@@ -345,7 +349,8 @@ mod tests {
     }
 
     /// The sort leaves each cell's particles in id order whatever their storage order, and
-    /// the parked ones after every cell in storage order (an inlet takes them in that order).
+    /// the parked ones after every cell in storage order (an inlet takes them in that order);
+    /// an id given twice stops it rather than leaving a slot unwritten.
     #[test]
     fn the_sort_orders_each_cell_by_id_and_keeps_the_parked_in_storage_order() {
         let (mut grid, cell) = twelve_by_nine();
@@ -369,6 +374,11 @@ mod tests {
         // the parked slots 3 and 5 as stored.
         assert_eq!(order, [4, 1, 2, 6, 0, 3, 5]);
         assert_eq!(grid.active(), 5);
+        let twice = std::panic::catch_unwind(move || {
+            let ids = [6, 4, 1, 0, 2, 5, 4];
+            grid.sort(&positions, &ids, Some(parked))
+        });
+        assert!(twice.is_err(), "an id given twice went unnoticed");
     }
 
     /// Every particle inside a box lies in a row `rows_in_box` visits, for boxes from a tenth
