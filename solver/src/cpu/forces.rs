@@ -2,7 +2,7 @@
 //! (`PairModel::add_pair`, the one statement of the formulas) over the contiguous rows of the
 //! cell list, particles shared out among threads in blocks. A block is taken in groups of up
 //! to [`LANES`] particles of one row of cells, each neighbour against the whole group at once
-//! (`physics::lanes`), a group packed with the particles that walk alone (`Grid::group`);
+//! (`physics::lanes`), a group packed with the particles that walk alone (`Grid::groups`);
 //! every lane sums its own neighbours in sorted order, as one particle alone would, so the
 //! result does not depend on the grouping or on the number of threads.
 //!
@@ -135,7 +135,7 @@ impl Pass<'_> {
 
     /// The particles of at most [`BLOCK`] from sorted index `first`: the pair sums of those
     /// that walk their neighbours, in groups of one row of cells packed with them alone
-    /// ([`Grid::group`]), then the wall sums of the wet walls packed the same way, then each
+    /// ([`Grid::groups`]), then the wall sums of the wet walls packed the same way, then each
     /// particle's forces; returns how many walls were spared the walk over their neighbours.
     #[inline(always)]
     fn chunk(&self, first: usize, forces: &mut [[f32; 4]], dt_limit: &mut [f32]) -> usize {
@@ -191,14 +191,18 @@ impl Pass<'_> {
         take: impl Fn(usize) -> bool,
         mut walk: impl FnMut(&Group),
     ) {
-        let mut start = first;
-        while start < end {
-            let (stretch, group) = self.grid.group((start, end), |k| self.sides[k].x, &take);
-            if let Some(group) = group {
-                walk(&group);
-            }
-            start = stretch.end;
-        }
+        let x = |k: usize| self.sides[k].x;
+        self.grid.groups(
+            (first, end),
+            x,
+            take,
+            #[inline(always)]
+            |_, group| {
+                if let Some(group) = group {
+                    walk(group);
+                }
+            },
+        );
     }
 
     /// The lane-pairs the walks of the particles from `first` to `end` evaluate, and those

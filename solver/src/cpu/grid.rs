@@ -174,6 +174,26 @@ impl Grid {
 }
 
 impl Grid {
+    /// Calls `walk` with each stretch of the sorted order from `first` to `end` that one
+    /// group is taken from ([`Grid::group`]), in order, and its group: None where `take`
+    /// accepts none of the stretch. The particles of a stretch that `take` refuses are the
+    /// caller's to handle.
+    #[inline(always)]
+    pub fn groups(
+        &self,
+        (first, end): (usize, usize),
+        x: impl Fn(usize) -> [f32; 3],
+        take: impl Fn(usize) -> bool,
+        mut walk: impl FnMut(Range<usize>, Option<&Group>),
+    ) {
+        let mut start = first;
+        while start < end {
+            let (stretch, group) = self.group((start, end), &x, &take);
+            start = stretch.end;
+            walk(stretch, group.as_ref());
+        }
+    }
+
     /// The group from sorted particle `first` (up to `end`): the particles `take` accepts,
     /// [`LANES`] at most, of `first`'s row of cells (same y and z) and within [`GROUP_SPAN`]
     /// cells of each other along it, `x(k)` being where particle k is (the cells of a grid
@@ -183,7 +203,7 @@ impl Grid {
     /// stretch of the sorted order it was taken from (never empty) and the group, None where
     /// it takes nobody.
     #[inline(always)]
-    pub fn group(
+    fn group(
         &self,
         (first, end): (usize, usize),
         x: impl Fn(usize) -> [f32; 3],
@@ -450,14 +470,14 @@ mod tests {
         assert!(falling > 10, "{falling}");
         for take_every in [1, 2, 3] {
             let take = |k: usize| k.is_multiple_of(take_every);
-            let mut start = 0;
-            while start < pos.len() {
-                let (stretch, group) = grid.group((start, pos.len()), x_of, take);
+            let mut next = 0;
+            grid.groups((0, pos.len()), x_of, take, |stretch, group| {
+                assert_eq!(stretch.start, next, "the stretches leave none out");
                 assert!(!stretch.is_empty());
+                next = stretch.end;
                 let Some(group) = group else {
                     assert!(!stretch.clone().any(take));
-                    start = stretch.end;
-                    continue;
+                    return;
                 };
                 let mut walked = vec![Vec::new(); LANES];
                 grid.group_cells(&group, |range, near| {
@@ -473,8 +493,8 @@ mod tests {
                     grid.rows(grid.coords(&x_of(i)), |range| own.extend(range));
                     assert_eq!(walked[lane], own, "particle {i}");
                 }
-                start = stretch.end;
-            }
+            });
+            assert_eq!(next, pos.len());
         }
     }
 

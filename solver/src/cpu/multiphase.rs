@@ -324,7 +324,7 @@ struct Pairs<'a> {
 impl Pairs<'_> {
     /// The rheology of the particles from `first` into `out`, in groups of one row of cells
     /// as the force pass takes them, the particles it spares left out of them
-    /// ([`Grid::group`]); each lane sums its own neighbours in sorted order.
+    /// ([`Grid::groups`]); each lane sums its own neighbours in sorted order.
     /// Returns how many were spared the walk over their neighbours. With [`deep`]'s rule each
     /// particle's record goes to `records`: a sleeper keeps its own.
     #[inline(always)]
@@ -332,43 +332,46 @@ impl Pairs<'_> {
         let mut asleep = 0;
         let (pass, pos, vel) = (self.pass, self.pos, self.vel);
         let end = first + out.len();
-        let mut start = first;
         // A sleeper's sums give it what its start does, and a wall's rheology is none
         // whatever its neighbours.
         let spared = |i: usize| self.asleep[i] || !self.params.phases[phase_index(&pos[i])].mobile;
-        while start < end {
-            let (stretch, group) =
-                self.grid
-                    .group((start, end), |k| self.sides[k].x, |k| !spared(k));
-            for i in stretch.clone().filter(|&i| spared(i)) {
-                asleep += 1;
-                let id = self.ids[i] as usize;
-                records[i - first] = self.records.get(id).copied().unwrap_or(NO_RECORD);
-                let s = pass.start(&pos[i], &vel[i]);
-                let before = (self.words[i], self.ids[i]);
-                let r = &mut out[i - first];
-                *r = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
-                // At rest under no water a grain at the top passes on nothing, and offers to
-                // take what a wet front brings.
-                let top = |t: &[u8]| t[id] == BED_TOP;
-                if self.asleep[i] && self.bed_tops.is_some_and(top) {
-                    r.flux = 0.0;
-                }
-            }
-            if let Some(group) = group {
-                let sums = self.group(&group);
-                for (lane, &i) in group.taken().iter().enumerate() {
-                    let s = sums.lane(lane);
-                    if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
-                        records[i - first] = d.record(s.kernel_mass());
-                    }
-                    let exchange = self.exchange(i, &s);
+        let x = |k: usize| self.sides[k].x;
+        let take = |k: usize| !spared(k);
+        self.grid.groups(
+            (first, end),
+            x,
+            take,
+            #[inline(always)]
+            |stretch: std::ops::Range<usize>, group: Option<&Group>| {
+                for i in stretch.filter(|&i| spared(i)) {
+                    asleep += 1;
+                    let id = self.ids[i] as usize;
+                    records[i - first] = self.records.get(id).copied().unwrap_or(NO_RECORD);
+                    let s = pass.start(&pos[i], &vel[i]);
                     let before = (self.words[i], self.ids[i]);
-                    out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, exchange);
+                    let r = &mut out[i - first];
+                    *r = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
+                    // At rest under no water a grain at the top passes on nothing, and offers to
+                    // take what a wet front brings.
+                    let top = |t: &[u8]| t[id] == BED_TOP;
+                    if self.asleep[i] && self.bed_tops.is_some_and(top) {
+                        r.flux = 0.0;
+                    }
                 }
-            }
-            start = stretch.end;
-        }
+                if let Some(group) = group {
+                    let sums = self.group(group);
+                    for (lane, &i) in group.taken().iter().enumerate() {
+                        let s = sums.lane(lane);
+                        if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
+                            records[i - first] = d.record(s.kernel_mass());
+                        }
+                        let exchange = self.exchange(i, &s);
+                        let before = (self.words[i], self.ids[i]);
+                        out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, exchange);
+                    }
+                }
+            },
+        );
         asleep
     }
 
