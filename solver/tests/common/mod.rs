@@ -8,6 +8,7 @@ pub mod parked;
 pub mod probe;
 pub mod sand_stages;
 pub mod stages;
+pub mod tank;
 
 use flume_solver::{Backend, GpuContext, Particles};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
