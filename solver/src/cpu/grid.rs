@@ -480,7 +480,7 @@ mod tests {
                     return;
                 };
                 let mut walked = vec![Vec::new(); LANES];
-                grid.group_cells(&group, |range, near| {
+                grid.group_cells(group, |range, near| {
                     for (lane, w) in walked.iter_mut().enumerate() {
                         if near.0[lane] != 0 {
                             w.extend(range.clone());
