@@ -175,7 +175,7 @@ impl Grid {
 
 impl Grid {
     /// Calls `walk` with each stretch of the sorted order from `first` to `end` that one
-    /// group is taken from ([`Grid::group`]), in order, and its group: None where `take`
+    /// group is taken from (`Grid::group`), in order, and its group: None where `take`
     /// accepts none of the stretch. The particles of a stretch that `take` refuses are the
     /// caller's to handle.
     #[inline(always)]

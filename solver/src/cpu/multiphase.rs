@@ -330,49 +330,62 @@ impl Pairs<'_> {
     #[inline(always)]
     fn block(&self, first: usize, out: &mut [ParticleRheology], records: &mut [f32]) -> usize {
         let mut asleep = 0;
-        let (pass, pos, vel) = (self.pass, self.pos, self.vel);
+        let pos = self.pos;
         let end = first + out.len();
         // A sleeper's sums give it what its start does, and a wall's rheology is none
         // whatever its neighbours.
         let spared = |i: usize| self.asleep[i] || !self.params.phases[phase_index(&pos[i])].mobile;
-        let x = |k: usize| self.sides[k].x;
-        let take = |k: usize| !spared(k);
         self.grid.groups(
             (first, end),
-            x,
-            take,
+            |k| self.sides[k].x,
+            |k| !spared(k),
             #[inline(always)]
-            |stretch: std::ops::Range<usize>, group: Option<&Group>| {
+            |stretch, group| {
                 for i in stretch.filter(|&i| spared(i)) {
                     asleep += 1;
-                    let id = self.ids[i] as usize;
-                    records[i - first] = self.records.get(id).copied().unwrap_or(NO_RECORD);
-                    let s = pass.start(&pos[i], &vel[i]);
-                    let before = (self.words[i], self.ids[i]);
-                    let r = &mut out[i - first];
-                    *r = pass.finish(&pos[i], &vel[i], &s, before, NONE_PASSED);
-                    // At rest under no water a grain at the top passes on nothing, and offers to
-                    // take what a wet front brings.
-                    let top = |t: &[u8]| t[id] == BED_TOP;
-                    if self.asleep[i] && self.bed_tops.is_some_and(top) {
-                        r.flux = 0.0;
-                    }
+                    (out[i - first], records[i - first]) = self.unwalked(i);
                 }
                 if let Some(group) = group {
-                    let sums = self.group(group);
-                    for (lane, &i) in group.taken().iter().enumerate() {
-                        let s = sums.lane(lane);
-                        if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
-                            records[i - first] = d.record(s.kernel_mass());
-                        }
-                        let exchange = self.exchange(i, &s);
-                        let before = (self.words[i], self.ids[i]);
-                        out[i - first] = pass.finish(&pos[i], &vel[i], &s, before, exchange);
-                    }
+                    self.walk(group, first, out, records);
                 }
             },
         );
         asleep
+    }
+
+    /// The rheology of particle `i`, spared the walk, from its own start, and the record it
+    /// keeps.
+    #[inline(always)]
+    fn unwalked(&self, i: usize) -> (ParticleRheology, f32) {
+        let (x, v, id) = (&self.pos[i], &self.vel[i], self.ids[i]);
+        let s = self.pass.start(x, v);
+        let mut r = self.pass.finish(x, v, &s, (self.words[i], id), NONE_PASSED);
+        // At rest under no water a grain at the top passes on nothing, and offers to take
+        // what a wet front brings.
+        let top = |t: &[u8]| t[id as usize] == BED_TOP;
+        if self.asleep[i] && self.bed_tops.is_some_and(top) {
+            r.flux = 0.0;
+        }
+        let record = self.records.get(id as usize).copied();
+        (r, record.unwrap_or(NO_RECORD))
+    }
+
+    /// The rheology of the particles `group` takes into `out` (and their records), from
+    /// their sums over their neighbours; `first` is the sorted index of `out`'s first slot.
+    #[inline(always)]
+    fn walk(&self, group: &Group, first: usize, out: &mut [ParticleRheology], records: &mut [f32]) {
+        let sums = self.group(group);
+        for (lane, &i) in group.taken().iter().enumerate() {
+            let s = sums.lane(lane);
+            if let Some(d) = self.deep.filter(|_| self.recordable[i]) {
+                records[i - first] = d.record(s.kernel_mass());
+            }
+            let exchange = self.exchange(i, &s);
+            let before = (self.words[i], self.ids[i]);
+            out[i - first] = self
+                .pass
+                .finish(&self.pos[i], &self.vel[i], &s, before, exchange);
+        }
     }
 
     /// The bed load passed to particle `i` in the last pass ([`passed`]) and the particle it
