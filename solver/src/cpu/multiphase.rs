@@ -103,41 +103,10 @@ pub fn rheology_pass(
     holds: &Holds,
     release: bool,
 ) -> RheologyPass {
-    let held_before = |i: usize| holds.words[i] & REGION_HELD != 0;
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = holds.words.len();
     let exner = model.exner();
-    let stirrers = holds
-        .awake_set
-        .then(|| stirring(params, (pos, vel), holds.words));
-    let named = exner.then(|| named(holds.fluxes));
-    // Under Exner's balance a grain sleeps only where its last walk is known and no load was
-    // named to it (see the module doc).
-    let may_sleep = |i: usize| {
-        let id = holds.ids[i] as usize;
-        !exner || (holds.bed_tops[id] != BED_UNKNOWN && named.as_ref().is_some_and(|n| !n[id]))
-    };
-    let deep = stirrers
-        .as_ref()
-        .and_then(|_| Deep::new(params, model, &pass, (pos, vel), holds.words));
-    let record_of = |i: usize| {
-        let id = holds.ids[i] as usize;
-        holds.records.get(id).copied().unwrap_or(NO_RECORD)
-    };
-    // Whether a held grain sleeps, and whether its walk, if it takes one, leaves a record
-    // ([`deep`]): a dry grain sleeps, and under the water a quiet one whose record allows.
-    let state = |i: usize, x: &[f32; 3]| {
-        if !held_before(i) {
-            return (false, false);
-        }
-        let dry = stirrers.as_ref().is_some_and(|s| !grid.any_near(s, x));
-        if dry {
-            return (may_sleep(i), deep.is_some());
-        }
-        let quiet = deep.as_ref().is_some_and(|d| d.quiet(grid, x));
-        let deep_asleep = quiet && deep.as_ref().is_some_and(|d| d.sleeps(record_of(i)));
-        (deep_asleep && may_sleep(i), quiet)
-    };
+    let sleepers = Sleepers::new((params, model), &pass, grid, (pos, vel), holds);
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed).
     type Sleep = (Vec<bool>, Vec<bool>);
@@ -148,7 +117,7 @@ pub fn rheology_pass(
                 .into_par_iter()
                 .map(|i| {
                     let side = pass.side(&pos[i], &vel[i]);
-                    let state = state(i, &side.x);
+                    let state = sleepers.state(i, &side.x);
                     // In sorted order: the loads are summed and weighed in that order.
                     let flux = holds.fluxes.get(holds.ids[i] as usize);
                     let flux = *flux.unwrap_or(&(NO_FLUX, NO_TARGET));
@@ -173,21 +142,12 @@ pub fn rheology_pass(
         words: holds.words,
         asleep: &asleep,
         bed_tops: exner.then_some(holds.bed_tops),
-        deep: deep.as_ref(),
+        deep: sleepers.deep.as_ref(),
         recordable: &recordable,
         records: holds.records,
     };
     // Every slot is written by its block.
-    let none = ParticleRheology {
-        stress: [[0.0; 3]; 3],
-        mu: 0.0,
-        region: 0,
-        held: false,
-        pickup: 0,
-        flux: NO_FLUX,
-        target: NO_TARGET,
-    };
-    let mut out = vec![none; n];
+    let mut out = vec![NO_RHEOLOGY; n];
     let mut records = vec![NO_RECORD; n];
     let asleep = pool.install(|| {
         out.par_chunks_mut(BLOCK)
@@ -204,13 +164,93 @@ pub fn rheology_pass(
     if release {
         release_held(pool, (params, model), grid, (pos, vel), &mut out);
     }
-    if deep.is_none() {
+    if sleepers.deep.is_none() {
         records.clear();
     }
     RheologyPass {
         out,
         asleep,
         records,
+    }
+}
+
+/// What a slot of the pass's output holds before its block writes it.
+const NO_RHEOLOGY: ParticleRheology = ParticleRheology {
+    stress: [[0.0; 3]; 3],
+    mu: 0.0,
+    region: 0,
+    held: false,
+    pickup: 0,
+    flux: NO_FLUX,
+    target: NO_TARGET,
+};
+
+/// What decides which held grains sleep in a pass (see the module doc).
+struct Sleepers<'a> {
+    grid: &'a Grid,
+    holds: &'a Holds<'a>,
+    /// With the awake set, the particles whose presence in reach wakes a dry grain.
+    stirrers: Option<Flagged>,
+    /// Under `van_rijn_exner`, by id, whether the last pass named the particle to take load.
+    named: Option<Vec<bool>>,
+    exner: bool,
+    /// Where held grains under the water may sleep ([`deep`]).
+    deep: Option<Deep>,
+}
+
+impl<'a> Sleepers<'a> {
+    fn new(
+        (params, model): (&Params, &SedimentModel),
+        pass: &Rheology,
+        grid: &'a Grid,
+        (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+        holds: &'a Holds<'a>,
+    ) -> Sleepers<'a> {
+        let exner = model.exner();
+        let stirrers = holds
+            .awake_set
+            .then(|| stirring(params, (pos, vel), holds.words));
+        let deep = stirrers
+            .as_ref()
+            .and_then(|_| Deep::new(params, model, pass, (pos, vel), holds.words));
+        Sleepers {
+            grid,
+            holds,
+            stirrers,
+            named: exner.then(|| named(holds.fluxes)),
+            exner,
+            deep,
+        }
+    }
+
+    /// Whether the grain at sorted index `i`, at `x`, sleeps, and whether its walk, if it
+    /// takes one, leaves a record ([`deep`]): a dry held grain sleeps, and under the water a
+    /// quiet one whose record allows.
+    fn state(&self, i: usize, x: &[f32; 3]) -> (bool, bool) {
+        if self.holds.words[i] & REGION_HELD == 0 {
+            return (false, false);
+        }
+        let dry = (self.stirrers.as_ref()).is_some_and(|s| !self.grid.any_near(s, x));
+        if dry {
+            return (self.may_sleep(i), self.deep.is_some());
+        }
+        let quiet = self.deep.as_ref().is_some_and(|d| d.quiet(self.grid, x));
+        let deep_asleep = quiet && self.deep.as_ref().is_some_and(|d| d.sleeps(self.record(i)));
+        (deep_asleep && self.may_sleep(i), quiet)
+    }
+
+    /// Under Exner's balance a grain sleeps only where its last walk is known and no load was
+    /// named to it (see the module doc).
+    fn may_sleep(&self, i: usize) -> bool {
+        let id = self.holds.ids[i] as usize;
+        let named = self.named.as_ref().is_some_and(|n| !n[id]);
+        !self.exner || (self.holds.bed_tops[id] != BED_UNKNOWN && named)
+    }
+
+    /// The record the last walk of the grain at sorted index `i` left.
+    fn record(&self, i: usize) -> f32 {
+        let id = self.holds.ids[i] as usize;
+        self.holds.records.get(id).copied().unwrap_or(NO_RECORD)
     }
 }
 
