@@ -147,7 +147,7 @@ pub fn rheology_pass(
         records: holds.records,
     };
     // Every slot is written by its block.
-    let mut out = vec![NO_RHEOLOGY; n];
+    let mut out = vec![ParticleRheology::NONE; n];
     let mut records = vec![NO_RECORD; n];
     let asleep = pool.install(|| {
         out.par_chunks_mut(BLOCK)
@@ -173,17 +173,6 @@ pub fn rheology_pass(
         records,
     }
 }
-
-/// What a slot of the pass's output holds before its block writes it.
-const NO_RHEOLOGY: ParticleRheology = ParticleRheology {
-    stress: [[0.0; 3]; 3],
-    mu: 0.0,
-    region: 0,
-    held: false,
-    pickup: 0,
-    flux: NO_FLUX,
-    target: NO_TARGET,
-};
 
 /// What decides which held grains sleep in a pass (see the module doc).
 struct Sleepers<'a> {

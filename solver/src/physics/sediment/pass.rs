@@ -140,6 +140,17 @@ pub const NO_FLUX: f32 = -1.0;
 pub const REGION_HELD: u32 = 256;
 
 impl ParticleRheology {
+    /// A wall's rheology: no stress, no viscosity, no region, not held, no bed load.
+    pub const NONE: ParticleRheology = ParticleRheology {
+        stress: [[0.0; 3]; 3],
+        mu: 0.0,
+        region: 0,
+        held: false,
+        pickup: 0,
+        flux: NO_FLUX,
+        target: NO_TARGET,
+    };
+
     /// The region word the backends store per particle: the region, `REGION_HELD`, and above
     /// them the mass picked up so far.
     pub fn word(&self) -> u32 {
@@ -356,15 +367,7 @@ impl<'a> Rheology<'a> {
         let params = self.params;
         let phase_i = &params.phases[phase_index(x_i)];
         if !phase_i.mobile {
-            return ParticleRheology {
-                stress: [[0.0; 3]; 3],
-                mu: 0.0,
-                region: 0,
-                held: false,
-                pickup: 0,
-                flux: NO_FLUX,
-                target: NO_TARGET,
-            };
+            return ParticleRheology::NONE;
         }
         let eps = strain_rate(&s.grad, params.dim);
         let ii_d = second_invariant(&eps);
