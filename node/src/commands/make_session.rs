@@ -163,14 +163,9 @@ impl Noise {
     }
 }
 
-pub fn run(args: &MakeSessionArgs) -> Result<()> {
-    let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
-    let flume = case
-        .open_flume
-        .clone()
-        .context("the case has no open flume")?;
-    let channel = Channel::from_case(&case).map_err(anyhow::Error::msg)?;
-    let mut schedule = vec![(0.0, flume.inflow_m3_per_s)];
+/// The discharge from t = 0 (the case's) and, with `--change-at-s`, the one it changes to.
+fn schedule(args: &MakeSessionArgs, case_m3_per_s: f64) -> Result<Vec<(f64, f64)>> {
+    let mut schedule = vec![(0.0, case_m3_per_s)];
     if let Some(t) = args.change_at_s {
         let q = args
             .change_to_m3_per_h
@@ -178,7 +173,21 @@ pub fn run(args: &MakeSessionArgs) -> Result<()> {
             / 3600.0;
         schedule.push((t, q));
     }
-    let model = LevelModel::new(channel, flume.width_m, schedule)?;
+    Ok(schedule)
+}
+
+pub fn run(args: &MakeSessionArgs) -> Result<()> {
+    let case = Case::from_path_with(&args.case, &args.set).context("the case file was refused")?;
+    let flume = case
+        .open_flume
+        .clone()
+        .context("the case has no open flume")?;
+    let channel = Channel::from_case(&case).map_err(anyhow::Error::msg)?;
+    let model = LevelModel::new(
+        channel,
+        flume.width_m,
+        schedule(args, flume.inflow_m3_per_s)?,
+    )?;
     let mut bag = BagWriter::create(&args.out, None)?;
     let frame_id = "flume".to_string();
     let inflow_ch =

@@ -156,11 +156,7 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         plots: plots.as_mut(),
     };
     let ran = lock_step(args, &mut twin, &feed, &mut reports, sinks)?;
-    let refused: Vec<String> = twin
-        .refused()
-        .iter()
-        .map(|(k, n)| format!("{k} {n}"))
-        .collect();
+    let refused = refused_inputs(twin.refused());
     // Closing the solver's channel stops it.
     drop(twin);
     if solver.handle.join().is_err() {
@@ -182,14 +178,19 @@ pub fn run(args: &ReplayArgs, ros_args: &[String]) -> Result<()> {
         t / wall.max(1e-9),
         ran.steps,
         ran.chunks,
-        if refused.is_empty() {
-            "none".to_string()
-        } else {
-            refused.join(", ")
-        },
+        refused,
         feed.undecodable
     );
     Ok(())
+}
+
+/// The inputs the twin refused, by reason: "none", or "reason count, ...".
+fn refused_inputs(refused: &std::collections::BTreeMap<&'static str, u64>) -> String {
+    if refused.is_empty() {
+        return "none".to_string();
+    }
+    let each: Vec<String> = refused.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    each.join(", ")
 }
 
 /// The case `--config` names with its `--set`s, which must have an open flume.

@@ -9,7 +9,8 @@ use crate::adapters::table::{Table, sci, sig};
 use crate::cli::SimulateArgs;
 use anyhow::{Context, Result, bail};
 use flume_solver::{
-    Backend, BoundaryConditions, Case, InflowSchedule, Observations, Simulation, SolverError,
+    Backend, BoundaryConditions, Case, InflowSchedule, Observations, ProfileColumn, Simulation,
+    SolverError,
 };
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -92,16 +93,27 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     bar.finish_and_clear();
     let wall_s = started.elapsed().as_secs_f64();
     if recorder.has_bed_profile() {
-        if bed_plot::holds_sediment(&bed_profiles) {
-            let path = out_dir.join("bed.png");
-            bed_plot::draw(&path, &case.name, &initial_profile, &bed_profiles)?;
-            println!("bed plot: {}", path.display());
-        } else {
-            println!("bed plot: none, no profile column held sediment");
-        }
+        draw_bed(&out_dir, &case.name, &initial_profile, &bed_profiles)?;
     }
     draw_series(&out_dir, &case.name, &plots, &recorder)?;
     print_summary(&sim, &last, wall_s);
+    Ok(())
+}
+
+/// The bed plot, a panel per quarter of the run, where any profile column held sediment.
+fn draw_bed(
+    out_dir: &Path,
+    name: &str,
+    initial: &[ProfileColumn],
+    quarters: &[(f64, Vec<ProfileColumn>)],
+) -> Result<()> {
+    if !bed_plot::holds_sediment(quarters) {
+        println!("bed plot: none, no profile column held sediment");
+        return Ok(());
+    }
+    let path = out_dir.join("bed.png");
+    bed_plot::draw(&path, name, initial, quarters)?;
+    println!("bed plot: {}", path.display());
     Ok(())
 }
 
