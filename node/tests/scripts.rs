@@ -265,6 +265,150 @@ fn figure9_chart_draws_each_run_s_front_against_time() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A snapshot as the twin writes it (legacy binary VTK, big-endian) of `(x, y, u, phase)`
+/// particles at rest density, at `t` s.
+fn snapshot(t: f64, particles: &[(f32, f32, f32, i32)]) -> Vec<u8> {
+    let n = particles.len();
+    let mut b = format!(
+        "# vtk DataFile Version 3.0\nflume-twin test t = {t} s step 0\nBINARY\n\
+         DATASET UNSTRUCTURED_GRID\nPOINTS {n} float\n"
+    )
+    .into_bytes();
+    for &(x, y, _, _) in particles {
+        [x, y, 0.0].iter().for_each(|v| b.extend(v.to_be_bytes()));
+    }
+    b.extend(format!("\nCELLS {n} {}\n", 2 * n).bytes());
+    for k in 0..n as i32 {
+        [1, k].iter().for_each(|v| b.extend(v.to_be_bytes()));
+    }
+    b.extend(format!("\nCELL_TYPES {n}\n").bytes());
+    (0..n).for_each(|_| b.extend(1i32.to_be_bytes()));
+    b.extend(format!("\nPOINT_DATA {n}\nVECTORS velocity float\n").bytes());
+    for &(_, _, u, _) in particles {
+        [u, 0.0, 0.0].iter().for_each(|v| b.extend(v.to_be_bytes()));
+    }
+    b.extend(b"\nSCALARS density float 1\nLOOKUP_TABLE default\n");
+    for &(_, _, _, phase) in particles {
+        let rho: f32 = if phase == 2 { 2710.0 } else { 1000.0 };
+        b.extend(rho.to_be_bytes());
+    }
+    b.extend(b"\nSCALARS phase int 1\nLOOKUP_TABLE default\n");
+    particles.iter().for_each(|p| b.extend(p.3.to_be_bytes()));
+    b.push(b'\n');
+    b
+}
+
+/// `pit_current.py` on two snapshots written by hand, dp = 1 cm: water 8 rows deep (centres
+/// 0.01-0.08 m) over x = 2.2-2.5 m, a weir of walls at x >= 2.49 m whose top particle is at
+/// 0.050 m (crest 0.055 m). At 30 s the column [2.30, 2.32) carries u = 0.3 m/s in its top row
+/// (25 mm over the crest), 0.2 in the row under it and -0.1 in its bottom row, two particles a
+/// row: q = (0.6 + 0.4 - 0.2) 1e-4 / 0.02 = 4e-3 m2/s, 1e-3 of it back; its core is 25 mm
+/// over the crest, two layers thick; its energy is the surface plus (2 0.3^3 + 2 0.2^3) /
+/// (2 0.3 + 2 0.2) / 2 g = 3.57 mm. The column [2.32, 2.34) carries 0.3 m/s only at 0.02 m:
+/// a plunged core, 35 mm under the crest. The surface of a full lattice lies about half a dp
+/// over its top row: 30 mm over the crest. The snapshot at 10 s, all at rest, lies before
+/// `--from-s` and must not count.
+#[test]
+fn pit_current_finds_the_core_of_the_current_and_its_energy() {
+    let dir = std::env::temp_dir().join(format!("flume-pit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let state = |moving: bool| {
+        let mut p = Vec::new();
+        for k in 0..4 {
+            let x = 2.485 + 0.01 * k as f32;
+            (0..6).for_each(|r| p.push((x + 0.005, 0.01 * r as f32, 0.0, 0)));
+        }
+        for c in 0..29 {
+            let x = 2.205 + 0.01 * c as f32;
+            for r in 0..8 {
+                let y = 0.01 * (r + 1) as f32;
+                let u = match (
+                    moving,
+                    (2.30..2.32).contains(&x),
+                    (2.32..2.34).contains(&x),
+                    r,
+                ) {
+                    (true, true, _, 7) => 0.3,
+                    (true, true, _, 6) => 0.2,
+                    (true, true, _, 0) => -0.1,
+                    (true, _, true, 1) => 0.3,
+                    _ => 0.0,
+                };
+                p.push((x, y, u, 1));
+            }
+        }
+        p
+    };
+    std::fs::write(
+        dir.join("particles_0000.vtk"),
+        snapshot(10.0, &state(false)),
+    )
+    .expect("vtk");
+    std::fs::write(dir.join("particles_0001.vtk"), snapshot(30.0, &state(true))).expect("vtk");
+    let out = Command::new("python3")
+        .arg(repo_file("scripts/pit_current.py"))
+        .arg(&dir)
+        .args([
+            "--dp", "0.01", "--from-s", "20", "--x0", "2.3", "--x1", "2.34",
+        ])
+        .output()
+        .expect("python3 runs");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<Vec<f64>> = (text.lines().skip(2))
+        .map(|l| l.split(',').map(|v| v.parse().expect("a number")).collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{text}");
+    let (a, b) = (&rows[0], &rows[1]);
+    assert!((a[1] - 30.0).abs() < 1.0, "the surface: {text}");
+    assert!(
+        (a[2] - 4e-3).abs() < 1e-6 && (a[3] + 1e-3).abs() < 1e-6,
+        "{text}"
+    );
+    assert!((a[4] - a[1] - 3.568).abs() < 0.02, "the energy: {text}");
+    assert_eq!((a[5], a[6], a[7], a[8]), (25.0, 0.3, 20.0, 1.0), "{text}");
+    assert_eq!((b[5], b[6], b[7]), (-35.0, 0.3, 10.0), "{text}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A directory with no snapshot, or one that is not the twin's, is refused by name.
+#[test]
+fn pit_current_names_what_it_cannot_read() {
+    let dir = std::env::temp_dir().join(format!("flume-pit-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let run = || {
+        Command::new("python3")
+            .arg(repo_file("scripts/pit_current.py"))
+            .arg(&dir)
+            .args(["--dp", "0.01"])
+            .output()
+            .expect("python3 runs")
+    };
+    let out = run();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        !out.status.success() && err.contains("no particles_*.vtk"),
+        "{err}"
+    );
+    std::fs::write(
+        dir.join("particles_0000.vtk"),
+        "# vtk DataFile Version 3.0\nother\nASCII\n",
+    )
+    .expect("file");
+    let out = run();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        !out.status.success() && err.contains("particles_0000.vtk"),
+        "{err}"
+    );
+    assert!(!err.contains("Traceback"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// One cargo message naming the test executable `dir/name` of `package`, from `tests/source`
 /// (cargo's JSON layout).
 fn test_artifact(dir: &std::path::Path, package: &str, name: &str, source: &str) -> String {
