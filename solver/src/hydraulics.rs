@@ -457,14 +457,12 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
                 .map(|b| block(&b.min_m, &b.max_m)),
         )
         .collect();
-    let pit = [channel.x_bed_end_m, channel.weir.floor_m];
-    let crest = [channel.weir.x_m, channel.weir.crest_m];
     let fluids: Vec<String> = case
         .fluid_blocks
         .iter()
         .filter(|b| !is_bed(&b.phase))
         .map(|b| fluid(&b.phase, &b.min_m, &b.max_m))
-        .chain([fluid(&water.name, &pit, &crest)])
+        .chain([pit_water(&channel, &water.name)])
         .collect();
     let mut overrides = vec![
         format!("walls.blocks=[{}]", walls.join(", ")),
@@ -474,6 +472,40 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
         overrides.push("open_flume.sill=null".into());
     }
     Ok(overrides)
+}
+
+/// The override (`Case::from_path_with`) that starts `case`'s collector pit full of still
+/// water to the crest, its sand bed as it is. The pit's current is not unique: filled by the
+/// first water falling into it, the pit's flow at dp = 5 mm and finer plunges to its floor and
+/// stays so; started full, it crosses the pit at the crest's level (README, "The pit's current
+/// at each dp"). A flume that has run before holds a full pit.
+pub fn filled_pit_override(case: &Case) -> Result<String, String> {
+    let channel = Channel::from_case(case)?;
+    let water = case
+        .phases
+        .iter()
+        .find(|p| p.sediment.is_none())
+        .ok_or_else(|| format!("{}: a pit of water needs a water phase", case.name))?;
+    let fluids: Vec<String> = case
+        .fluid_blocks
+        .iter()
+        .map(|b| {
+            format!(
+                "{{phase: {}, min_m: {:?}, max_m: {:?}}}",
+                b.phase, b.min_m, b.max_m
+            )
+        })
+        .chain([pit_water(&channel, &water.name)])
+        .collect();
+    Ok(format!("fluid_blocks=[{}]", fluids.join(", ")))
+}
+
+/// A fluid block of `phase` filling the collector pit from the bed's end to the weir's face,
+/// from the floor to the crest.
+fn pit_water(channel: &Channel, phase: &str) -> String {
+    let min = [channel.x_bed_end_m, channel.weir.floor_m];
+    let max = [channel.weir.x_m, channel.weir.crest_m];
+    format!("{{phase: {phase}, min_m: {min:?}, max_m: {max:?}}}")
 }
 
 #[cfg(test)]

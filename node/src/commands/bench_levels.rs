@@ -33,7 +33,9 @@ use crate::adapters::table::Table;
 use anyhow::{Context, Result, bail};
 use flume_solver::bed_contact::bed_contact;
 use flume_solver::config::GaugeConfig;
-use flume_solver::hydraulics::{Channel, GLASS_MANNING_N, PitFlow, SideWalls, fixed_bed_overrides};
+use flume_solver::hydraulics::{
+    Channel, GLASS_MANNING_N, PitFlow, SideWalls, filled_pit_override, fixed_bed_overrides,
+};
 use flume_solver::{Backend, Case, Observations, ParticleRegion, Particles, Simulation};
 use std::path::Path;
 use std::time::Instant;
@@ -55,6 +57,9 @@ pub struct LevelRun {
     pub until_s: f64,
     /// The sand bed replaced by a wall block of its shape (clear water).
     pub fixed_bed: bool,
+    /// The sand bed's collector pit full of still water at the start (a fixed bed's always
+    /// is).
+    pub filled_pit: bool,
 }
 
 /// The counters of the open flume at an observation.
@@ -118,6 +123,12 @@ fn level_case(flume: &Path, set: &[String], r: &LevelRun) -> Result<(Case, Chann
     let sand = Case::from_path_with(flume, &overrides)
         .with_context(|| format!("the flume at dp = {} m was refused", r.dp_m))?;
     let channel = Channel::as_generated(&sand).map_err(anyhow::Error::msg)?;
+    if r.filled_pit && !r.fixed_bed {
+        overrides.push(filled_pit_override(&sand).map_err(anyhow::Error::msg)?);
+        let filled = Case::from_path_with(flume, &overrides)
+            .with_context(|| format!("the flume with its pit filled at dp = {} m", r.dp_m))?;
+        return Ok((with_pool_gauge(filled, &channel), channel));
+    }
     if !r.fixed_bed {
         return Ok((with_pool_gauge(sand, &channel), channel));
     }
@@ -144,10 +155,10 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
         case.name,
         r.dp_m,
         r.m3_per_h,
-        if r.fixed_bed {
-            "the bed a fixed wall (clear water)"
-        } else {
-            "the sand bed"
+        match (r.fixed_bed, r.filled_pit) {
+            (true, _) => "the bed a fixed wall (clear water)",
+            (false, true) => "the sand bed, the collector pit full at the start",
+            (false, false) => "the sand bed",
         },
         r.until_s
     );

@@ -263,3 +263,42 @@ fn the_pits_length_chooses_its_limit() {
         PitFlow::Expanded
     );
 }
+
+/// The pit filled at the start (`bench --levels --filled-pit`) at dp = 1 cm: the sand bed is
+/// generated as before, particle for particle, and the new water lies in the pit alone, on
+/// the lattice points from the bed's end (2.23 m) to the weir's face and from the floor to the
+/// crest (0.055 m): x = 2.24-2.49 m (the weir's first column of walls is at 2.50) and y =
+/// 0.01-0.05 m (the floor's top row is at 0), 26 x 5 = 130 particles.
+#[test]
+fn a_filled_pit_adds_still_water_in_the_pit_alone() {
+    let path = std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../launch_configs/ulbra_flume.yaml"
+    ));
+    let dp = ["numerics.dp_m=0.01".to_string()];
+    let dry = crate::Case::from_path_with(path, &dp).expect("the bundled case");
+    let mut set = dp.to_vec();
+    set.push(super::filled_pit_override(&dry).expect("a pit to fill"));
+    let filled = crate::Case::from_path_with(path, &set).expect("the case, its pit filled");
+    let of_phase = |case: &crate::Case, code: u32| {
+        let p = crate::generate(case, &crate::derived::derive(case));
+        let at: Vec<[f32; 4]> = (0..p.len())
+            .filter(|&i| p.phase(i) == code)
+            .map(|i| p.positions[i])
+            .collect();
+        at
+    };
+    // Phase codes: 0 walls, 1 water, 2 sand.
+    assert_eq!(
+        of_phase(&dry, 2),
+        of_phase(&filled, 2),
+        "the sand bed moved"
+    );
+    let (before, after) = (of_phase(&dry, 1), of_phase(&filled, 1));
+    let new: Vec<&[f32; 4]> = after.iter().filter(|p| !before.contains(p)).collect();
+    assert_eq!(new.len(), 130, "{new:?}");
+    for p in new {
+        let inside = p[0] > 2.235 && p[0] < 2.495 && p[1] > 0.005 && p[1] < 0.055;
+        assert!(inside, "water outside the pit at {p:?}");
+    }
+}

@@ -43,6 +43,7 @@ fn ci_flume(until_s: f64) -> (std::path::PathBuf, LevelRun) {
         m3_per_h: 2.0,
         until_s,
         fixed_bed: false,
+        filled_pit: false,
     };
     (flume, run)
 }
