@@ -156,3 +156,24 @@ fn a_set_reservoir_is_kept() {
     let set = ["numerics.dp_m=0.02".to_string()];
     assert_eq!(reservoir(&set), 3000, "--dp is the benchmark's");
 }
+
+/// `--filled-pit` reaches the run's case: the sand bed's block stays, the pit's water is added,
+/// and the fixed bed, whose pit is always full, keeps its own blocks.
+#[test]
+fn a_filled_pit_run_starts_with_water_in_the_pit() {
+    let (flume, run) = ci_flume(60.0);
+    let blocks = |filled_pit: bool, fixed_bed: bool| {
+        let r = LevelRun {
+            filled_pit,
+            fixed_bed,
+            ..run
+        };
+        let (case, _) = level_case(&flume, &[], &r).expect("the CI flume");
+        let phases: Vec<String> = case.fluid_blocks.iter().map(|b| b.phase.clone()).collect();
+        phases
+    };
+    assert_eq!(blocks(false, false), ["sand"]);
+    assert_eq!(blocks(true, false), ["sand", "water"]);
+    assert_eq!(blocks(true, true), blocks(false, true));
+    assert_eq!(blocks(false, true), ["water"]);
+}
