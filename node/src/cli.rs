@@ -364,10 +364,11 @@ pub struct BenchArgs {
     /// With --levels: the sand bed replaced by a fixed wall block of its shape (clear water).
     #[arg(long, requires = "levels")]
     pub fixed_bed: bool,
-    /// With --levels: the sand bed's collector pit full of still water at the start, as in a
-    /// flume that has run before (the pit's current depends on how the pit filled).
+    /// With --levels: the sand bed's collector pit empty at the start, as the case writes it.
+    /// By default it starts full of still water to the crest, as in a flume that has run
+    /// before: the pit's current, and at dp = 5 mm the levels, depend on how the pit filled.
     #[arg(long, requires = "levels", conflicts_with = "fixed_bed")]
-    pub filled_pit: bool,
+    pub empty_pit: bool,
     /// Override a field of the flume case (repeatable), as `simulate --set`: of the timed
     /// flume, or with --levels of the flume run to a steady state.
     #[arg(long = "set", value_name = "KEY=VALUE")]

@@ -84,10 +84,12 @@ fn negative_dp_is_refused_by_name() {
 }
 
 /// `bench --levels` refuses what it cannot run before any run starts, saying which flag: a
-/// resolution that is no length, a run too short for a drift, a value the case refuses.
+/// resolution that is no length, a run too short for a drift, a value the case refuses, an
+/// empty collector pit asked of the fixed bed, whose pit is part of its clear-water block.
 #[test]
 fn bench_levels_refuses_bad_flags_before_it_runs() {
-    let cases: [(&[&str], &str); 3] = [
+    let cases: [(&[&str], &str); 4] = [
+        (&["--fixed-bed", "--empty-pit"], "--empty-pit"),
         (
             &["--dp", "0.01,-0.007"],
             "--dp: -0.007 is not a positive length",

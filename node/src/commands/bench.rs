@@ -77,7 +77,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 m3_per_h: args.m3_per_h,
                 until_s: args.until,
                 fixed_bed: args.fixed_bed,
-                filled_pit: args.filled_pit,
+                filled_pit: !args.empty_pit,
             })
             .collect();
         return super::bench_levels::run(&args.flume, &args.set, &runs);

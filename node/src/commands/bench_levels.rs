@@ -158,7 +158,7 @@ fn run_one(backend: &Backend, case: &Case, channel: &Channel, r: &LevelRun) -> R
         match (r.fixed_bed, r.filled_pit) {
             (true, _) => "the bed a fixed wall (clear water)",
             (false, true) => "the sand bed, the collector pit full at the start",
-            (false, false) => "the sand bed",
+            (false, false) => "the sand bed, the collector pit empty at the start",
         },
         r.until_s
     );

@@ -157,8 +157,9 @@ fn a_set_reservoir_is_kept() {
     assert_eq!(reservoir(&set), 3000, "--dp is the benchmark's");
 }
 
-/// `--filled-pit` reaches the run's case: the sand bed's block stays, the pit's water is added,
-/// and the fixed bed, whose pit is always full, keeps its own blocks.
+/// The full pit (the default; `--empty-pit` turns it off) reaches the run's case: the sand
+/// bed's block stays, the pit's water is added, and the fixed bed, whose pit is always full,
+/// keeps its own blocks.
 #[test]
 fn a_filled_pit_run_starts_with_water_in_the_pit() {
     let (flume, run) = ci_flume(60.0);
