@@ -323,7 +323,30 @@ impl<'a> PairModel<'a> {
             let other = near & !L::index_eq(i.phase, j.phase);
             self.add_contact(j, x_ij, r2, other, sum);
         }
-        // Pressure gradient, Eq. 10 with sigma = -p I.
+        let pair = PairGeometry {
+            x_ij,
+            f,
+            m_j,
+            valid: near,
+        };
+        self.add_momentum(i, j, (rho_j, p_j), (&pair, r2, v_ij, vdotr), sum);
+        Some(pair)
+    }
+
+    /// The pressure gradient (Eq. 10 with sigma = -p I) and the viscous term of pair `i`, `j`
+    /// in the lanes `pair.valid`, given j's density and p / rho^2 as `i` sees them.
+    #[inline(always)]
+    fn add_momentum<L: Real>(
+        &self,
+        i: &Side<L>,
+        j: &Side,
+        (rho_j, p_j): (L, L),
+        (pair, r2, v_ij, vdotr): (&PairGeometry<L>, L, [L; 3], L),
+        sum: &mut PairSum<L>,
+    ) {
+        let s = L::splat;
+        let params = self.params;
+        let (near, m_j, f, x_ij) = (pair.valid, pair.m_j, pair.f, pair.x_ij);
         let mut coef = -m_j * (i.p_over_rho2 + p_j);
         let mu_ij = s(params.h) * vdotr / (r2 + s(self.eta2));
         sum.visc_max = L::select(near, sum.visc_max.max(mu_ij.abs()), sum.visc_max);
@@ -346,12 +369,6 @@ impl<'a> PairModel<'a> {
                 }
             }
         }
-        Some(PairGeometry {
-            x_ij,
-            f,
-            m_j,
-            valid: near,
-        })
     }
 
     /// The contact force of held-bed particle `j` (a particle of a mobile phase standing as a
