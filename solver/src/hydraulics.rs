@@ -468,10 +468,11 @@ pub fn fixed_bed_overrides(case: &Case) -> Result<Vec<String>, String> {
 }
 
 /// The override (`Case::from_path_with`) that starts `case`'s collector pit full of still
-/// water to the crest, its sand bed as it is. The pit's current is not unique: filled by the
-/// first water falling into it, the pit's flow at dp = 5 mm and finer plunges to its floor and
-/// stayed so in every run to its end (50 s, 40 s at 4 mm); started full, it crosses the pit at the crest's level (README, "The pit's current
-/// at each dp"). A flume that has run before holds a full pit.
+/// water to the crest, its sand bed as it is: the level benchmark's start. The pit's current
+/// is not unique: filled by the first water falling into it, the pit's flow at dp = 5 mm and
+/// finer plunges to its floor and stayed so in every run to its end (50 s, 40 s at 4 mm);
+/// started full, it crosses the pit at the crest's level (README, "The pit's current at each
+/// dp"). A flume that has run before holds a full pit.
 pub fn filled_pit_override(case: &Case) -> Result<String, String> {
     let pit = pit_water(case, &Channel::from_case(case)?)?;
     let fluids: Vec<String> = case

@@ -69,18 +69,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         if let Some(dp) = args.dp.iter().find(|dp| !(dp.is_finite() && **dp > 0.0)) {
             bail!("--dp: {dp} is not a positive length in metres");
         }
-        let runs: Vec<super::bench_levels::LevelRun> = args
-            .dp
-            .iter()
-            .map(|&dp_m| super::bench_levels::LevelRun {
-                dp_m,
-                m3_per_h: args.m3_per_h,
-                until_s: args.until,
-                fixed_bed: args.fixed_bed,
-                filled_pit: !args.empty_pit,
-            })
-            .collect();
-        return super::bench_levels::run(&args.flume, &args.set, &runs);
+        return super::bench_levels::run(&args.flume, &args.set, &level_runs(args));
     }
     if let Some(n) = args.ladder.iter().find(|n| **n < 100) {
         bail!("--ladder: {n} particles is too few for a dam break; use at least 100");
@@ -473,11 +462,47 @@ fn count_lanes(sim: &mut Simulation, wall_s: f64) -> Result<Option<f64>> {
     Ok((evaluated > 0.0).then(|| (after.1 - before.1) as f64 / evaluated))
 }
 
+/// The runs `bench --levels` asks for, one per `--dp`: the sand bed's pit full unless
+/// `--empty-pit`.
+fn level_runs(args: &BenchArgs) -> Vec<super::bench_levels::LevelRun> {
+    (args.dp.iter())
+        .map(|&dp_m| super::bench_levels::LevelRun {
+            dp_m,
+            m3_per_h: args.m3_per_h,
+            until_s: args.until,
+            fixed_bed: args.fixed_bed,
+            filled_pit: !args.empty_pit,
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
     use flume_solver::{derive, generate};
     use std::path::Path;
+
+    /// The pit each run starts with, as the command line parses.
+    fn pits(extra: &[&str]) -> Vec<(bool, bool)> {
+        let mut argv = vec!["flume-twin", "bench", "--levels", "--dp", "0.01,0.005"];
+        argv.extend_from_slice(extra);
+        match Cli::parse_from(argv).command {
+            Command::Bench(a) => (level_runs(&a).iter())
+                .map(|r| (r.filled_pit, r.fixed_bed))
+                .collect(),
+            _ => unreachable!("parsed a bench"),
+        }
+    }
+
+    /// The benchmark's start is a full pit at every dp; `--empty-pit` is the case's start.
+    #[test]
+    fn level_runs_start_with_a_full_pit_unless_asked_empty() {
+        assert_eq!(pits(&[]), [(true, false), (true, false)]);
+        assert_eq!(pits(&["--empty-pit"]), [(false, false), (false, false)]);
+        assert_eq!(pits(&["--fixed-bed"]), [(true, true), (true, true)]);
+    }
 
     /// Fluid particles a case holds, counted on the CPU.
     fn fluid_of(case: &Case) -> usize {
