@@ -134,7 +134,7 @@ fn the_sand_out_of_the_bed_is_listed_by_x() {
     // Region 1 held, region 3 (bed load), water, a wall.
     let held = 1 | flume_solver::physics::sediment::pass::REGION_HELD;
     let regions = [held, 3, held, 5, 0];
-    let loose = loose_sand(&case, &channel, &particles, &regions);
+    let loose = bed::loose_sand(&case, &channel, &particles, &regions);
     assert_eq!(loose, vec![(2.163, 0.061, true), (2.305, 0.030, false)]);
 }
 
