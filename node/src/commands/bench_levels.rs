@@ -459,7 +459,7 @@ fn print_pool(
     let Some(level) = mean_level(history, g, r.until_s - WINDOW_S, r.until_s) else {
         return;
     };
-    let water = case.sediment_phases().map_or(1, |(_, w)| w as u32 + 1);
+    let water = water_code(case);
     let (x, dp) = (
         case.observations.gauges[g].position_m[0],
         case.numerics.dp_m,
@@ -495,6 +495,12 @@ fn print_pool(
         1e3 * approach(head),
         1e3 * approach(sharp)
     );
+}
+
+/// The water's phase code in `Particles::phase` (the case's index plus one; the only fluid
+/// phase where there is no sediment).
+fn water_code(case: &Case) -> u32 {
+    case.sediment_phases().map_or(1, |(_, w)| w as u32 + 1)
 }
 
 #[cfg(test)]

@@ -40,7 +40,7 @@ pub(super) fn print_bed(sim: &Simulation, case: &Case, particles: &Particles, re
     // Water can leave only over the weir: any below the floor went through a wall.
     let dp = case.numerics.dp_m;
     let floor = case.domain.min_m[1] - f64::from(case.walls.layers) * dp;
-    let water = case.sediment_phases().map_or(1, |(_, w)| w as u32 + 1);
+    let water = super::water_code(case);
     let lost = (0..particles.len())
         .filter(|&i| particles.phase(i) == water && f64::from(particles.positions[i][1]) < floor)
         .count();
