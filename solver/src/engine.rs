@@ -58,6 +58,10 @@ pub fn inlet_scan(
 pub struct StageTime {
     pub stage: &'static str,
     pub seconds: f64,
+    /// Of `seconds`, those in the parallel walk over the neighbours and each particle's own
+    /// work after it; the rest is the set-up and book-keeping around it (the sides, the
+    /// awake set's flags, what is stored by id), much of it on one thread.
+    pub walk_seconds: f64,
     pub particles: u64,
     pub asleep: u64,
     /// Lane-pairs its neighbour walks evaluated while counted (`Engine::count_lanes`), and

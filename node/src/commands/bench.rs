@@ -255,7 +255,19 @@ fn print_stages(m: &Measurement) {
     let parts: Vec<String> = m
         .stages
         .iter()
-        .map(|s| format!("{} {:.1} %", s.stage, 100.0 * s.seconds / m.wall_s))
+        .map(|s| {
+            let share = |seconds: f64| 100.0 * seconds / m.wall_s;
+            if s.walk_seconds > 0.0 {
+                format!(
+                    "{} {:.1} % (walk {:.1} %)",
+                    s.stage,
+                    share(s.seconds),
+                    share(s.walk_seconds)
+                )
+            } else {
+                format!("{} {:.1} %", s.stage, share(s.seconds))
+            }
+        })
         .collect();
     println!("  stages on {}: {}", m.backend, parts.join(", "));
     let awake: Vec<String> = m
@@ -419,6 +431,7 @@ fn measure_from(
         .map(|(now, before)| StageTime {
             stage: now.stage,
             seconds: now.seconds - before.seconds,
+            walk_seconds: now.walk_seconds - before.walk_seconds,
             particles: now.particles - before.particles,
             asleep: now.asleep - before.asleep,
             lane_pairs: 0,

@@ -321,26 +321,13 @@ impl Flagged {
 
 /// `values` in sorted order: slot k holds the value of storage index `order[k]`.
 #[cfg(test)]
-pub fn gather<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
-    gather_with(order, |i| values[i])
+pub fn gather<T: Copy>(values: &[T], order: &[u32]) -> Vec<T> {
+    order.iter().map(|&i| values[i as usize]).collect()
 }
 
-/// What `value` gives of each storage index, in sorted order, unzipped: slot k of each
-/// collection holds what `value(order[k])` gave.
-pub fn gather_with<T, C>(order: &[u32], value: impl Fn(usize) -> T + Send + Sync) -> C
-where
-    T: Send,
-    C: FromParallelIterator<T>,
-{
-    order
-        .par_iter()
-        .with_min_len(PAR_MIN)
-        .map(|&i| value(i as usize))
-        .collect()
-}
-
-/// Fewest particles a thread takes in the sort's parallel loops: less is not worth a wake-up.
-const PAR_MIN: usize = 4096;
+/// Fewest particles a thread takes in the sort's parallel loops (and the gather after it):
+/// less is not worth a wake-up.
+pub const PAR_MIN: usize = 4096;
 
 #[cfg(test)]
 mod tests {

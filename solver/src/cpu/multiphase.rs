@@ -85,6 +85,8 @@ pub fn bed_top_of(r: &ParticleRheology) -> u8 {
 pub struct RheologyPass {
     pub out: Vec<ParticleRheology>,
     pub asleep: usize,
+    /// Seconds in the walk over the neighbours (`StageTime::walk_seconds`).
+    pub walk_s: f64,
     /// Where held grains under the water may sleep ([`deep`]), the record each active particle
     /// leaves (sorted order; NaN: none), for [`Holds::records`]; empty elsewhere.
     pub records: Vec<f32>,
@@ -108,23 +110,29 @@ pub fn rheology_pass(
     let exner = model.exner();
     let sleepers = Sleepers::new((params, model), &pass, grid, (pos, vel), holds);
     // One parallel region, not two: a region costs a step more than its work at CI size
-    // (README, speed).
-    type Sleep = (Vec<bool>, Vec<bool>);
-    type Own = (Vec<f32>, Vec<(f32, u32)>);
-    let ((vol, fluxes), (sides, (asleep, recordable))): (Own, (Vec<RheologySide>, Sleep)) = pool
-        .install(|| {
-            (0..n)
-                .into_par_iter()
-                .map(|i| {
-                    let side = pass.side(&pos[i], &vel[i]);
-                    let state = sleepers.state(i, &side.x);
-                    // In sorted order: the loads are summed and weighed in that order.
-                    let flux = holds.fluxes.get(holds.ids[i] as usize);
-                    let flux = *flux.unwrap_or(&(NO_FLUX, NO_TARGET));
-                    ((pass.volume(&pos[i], &vel[i]), flux), (side, state))
-                })
-                .unzip()
+    // (README, speed). Each block writes its slots of the five in place: an `unzip` into
+    // vectors gathered each thread's pieces and joined them on one thread.
+    let mut vol = vec![0.0; n];
+    let mut fluxes = vec![(NO_FLUX, NO_TARGET); n];
+    let mut sides = vec![RheologySide::default(); n];
+    let (mut asleep, mut recordable) = (vec![false; n], vec![false; n]);
+    pool.install(|| {
+        let own = vol.par_chunks_mut(BLOCK).zip(fluxes.par_chunks_mut(BLOCK));
+        let sleep = asleep
+            .par_chunks_mut(BLOCK)
+            .zip(recordable.par_chunks_mut(BLOCK));
+        let blocks = own.zip(sides.par_chunks_mut(BLOCK)).zip(sleep).enumerate();
+        blocks.for_each(|(b, (((vol, fluxes), sides), (asleep, recordable)))| {
+            for (k, i) in (b * BLOCK..).take(vol.len()).enumerate() {
+                sides[k] = pass.side(&pos[i], &vel[i]);
+                (asleep[k], recordable[k]) = sleepers.state(i, &sides[k].x);
+                // In sorted order: the loads are summed and weighed in that order.
+                let flux = holds.fluxes.get(holds.ids[i] as usize);
+                fluxes[k] = *flux.unwrap_or(&(NO_FLUX, NO_TARGET));
+                vol[k] = pass.volume(&pos[i], &vel[i]);
+            }
         });
+    });
     // Read only where the pass wears the bed (`Rheology::exchange_of`).
     let wears = exner && holds.draws.is_some();
     let passed = wears.then(|| passed(&fluxes, holds.ids, holds.fluxes.len()));
@@ -149,6 +157,7 @@ pub fn rheology_pass(
     // Every slot is written by its block.
     let mut out = vec![ParticleRheology::NONE; n];
     let mut records = vec![NO_RECORD; n];
+    let walk = std::time::Instant::now();
     let asleep = pool.install(|| {
         out.par_chunks_mut(BLOCK)
             .zip(records.par_chunks_mut(BLOCK))
@@ -161,6 +170,7 @@ pub fn rheology_pass(
             })
             .sum()
     });
+    let walk_s = walk.elapsed().as_secs_f64();
     if release {
         release_held(pool, (params, model), grid, (pos, vel), &mut out);
     }
@@ -170,6 +180,7 @@ pub fn rheology_pass(
     RheologyPass {
         out,
         asleep,
+        walk_s,
         records,
     }
 }

@@ -111,6 +111,7 @@ impl CpuEngine {
             mobile: mobile.as_ref(),
         };
         let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
+        let walk = Instant::now();
         let asleep = force_pass(
             &self.pool,
             &model,
@@ -120,6 +121,7 @@ impl CpuEngine {
             &mut forces,
             &mut dt_limit,
         );
+        self.walk_seconds[STAGE_FORCES] += walk.elapsed().as_secs_f64();
         let lanes = self
             .count_lanes
             .then(|| lane_use(&self.pool, &model, grid, &sides, &extra));
@@ -157,6 +159,7 @@ impl CpuEngine {
         let (params, pool) = (&self.model, &self.pool);
         let pass = rheology_pass(pool, params, model, grid, pos, vel, &holds, release);
         self.count(STAGE_RHEOLOGY, active, pass.asleep);
+        self.walk_seconds[STAGE_RHEOLOGY] += pass.walk_s;
         for (r, &id) in pass.out.iter().zip(&b.ids) {
             self.regions[id as usize] = r.word();
         }
