@@ -29,6 +29,20 @@ fn asleep_share(before: &[StageTime], after: &[StageTime], stage: &str) -> f64 {
     (a1 - a0) as f64 / (p1 - p0).max(1) as f64
 }
 
+/// Each neighbour pass that ran between `before` and `after` spent time in its walk, and no
+/// more than the whole stage took (`bench` prints the walk's share of each).
+fn assert_walk_within_stage(before: &[StageTime], after: &[StageTime], t: f64) {
+    for (b, a) in before.iter().zip(after) {
+        let (stage, walk) = (a.seconds - b.seconds, a.walk_seconds - b.walk_seconds);
+        let walked = a.particles > b.particles;
+        assert!(
+            !walked || (walk > 0.0 && walk <= stage),
+            "{} to t = {t} s: walk {walk} s of a stage of {stage} s",
+            a.stage
+        );
+    }
+}
+
 /// Runs `case` to each of `times` with the awake set and without; the bits must agree at each.
 /// Returns the share of rheology and force passes that slept over the first and the last
 /// stretch.
@@ -52,6 +66,7 @@ fn assert_same_as_full(case: &Case, times: &[f64]) -> [(f64, f64); 2] {
             case.name
         );
         let after = a.stage_times();
+        assert_walk_within_stage(&before, &after, t);
         let share = |stage| asleep_share(&before, &after, stage);
         shares.push((share("rheology"), share("forces")));
         eprintln!(

@@ -111,7 +111,7 @@ pub fn rheology_pass(
     let sleepers = Sleepers::new((params, model), &pass, grid, (pos, vel), holds);
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed). Each block writes its slots of the five in place: an `unzip` into
-    // vectors gathered each thread's pieces and joined them on one thread.
+    // vectors gathers each thread's pieces and joins them on one thread.
     let mut vol = vec![0.0; n];
     let mut fluxes = vec![(NO_FLUX, NO_TARGET); n];
     let mut sides = vec![RheologySide::default(); n];
