@@ -288,6 +288,25 @@ impl<'a> Rheology<'a> {
     pub fn add_pair_of_volume<L: Real>(
         &self,
         i: &RheologySide<L>,
+        j: (&[f32; 4], &[f32; 4]),
+        vol_j: f32,
+        reach: L::Mask,
+        s: &mut RheologySums<L>,
+    ) {
+        // The dimension a constant: loops to a bound read at run time kept the lanes' sums in
+        // memory, each select a masked store that the next pair's load waited on.
+        if self.params.dim == 2 {
+            self.add_pair_in::<L, 2>(i, j, vol_j, reach, s);
+        } else {
+            self.add_pair_in::<L, 3>(i, j, vol_j, reach, s);
+        }
+    }
+
+    /// [`Rheology::add_pair_of_volume`] in `D` dimensions.
+    #[inline(always)]
+    fn add_pair_in<L: Real, const D: usize>(
+        &self,
+        i: &RheologySide<L>,
         (x_j, v_j): (&[f32; 4], &[f32; 4]),
         vol_j: f32,
         reach: L::Mask,
@@ -306,9 +325,8 @@ impl<'a> Rheology<'a> {
         let f = self.kernel.grad_factor(r);
         let du: [L; 3] = std::array::from_fn(|k| c(v_j[k]) - i.v[k]);
         // In 2-D the third row and column are zero: the loops stop at the dimension.
-        let dim = self.params.dim as usize;
-        for (row, d) in s.grad.iter_mut().zip(du).take(dim) {
-            for (g, x) in row.iter_mut().zip(x_ij).take(dim) {
+        for (row, d) in s.grad.iter_mut().zip(du).take(D) {
+            for (g, x) in row.iter_mut().zip(x_ij).take(D) {
                 *g = L::select(near, *g + c(vol_j) * d * x * f, *g);
             }
         }
@@ -324,7 +342,7 @@ impl<'a> Rheology<'a> {
             }
             // Counted only where the count is read: this is the pass's hottest loop.
             if model.rests_beside_solid {
-                let up = x_ij[(self.params.dim - 1) as usize];
+                let up = x_ij[D - 1];
                 let beside = near & level_solid(up, r2, model.dp_m);
                 s.level_solids = L::select(beside, s.level_solids + c(1.0), s.level_solids);
             }

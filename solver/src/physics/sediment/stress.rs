@@ -113,11 +113,26 @@ impl<'a> StressDivergence<'a> {
         g: &PairGeometry<L>,
         acc: &mut [L; 3],
     ) {
+        // The dimension a constant, as in `Rheology::add_pair_of_volume`.
+        if self.params.dim == 2 {
+            Self::add_term_in::<L, 2>(i, j, g, acc);
+        } else {
+            Self::add_term_in::<L, 3>(i, j, g, acc);
+        }
+    }
+
+    /// [`StressDivergence::add_term`] in `D` dimensions.
+    #[inline(always)]
+    fn add_term_in<L: Real, const D: usize>(
+        i: &StressSide<L>,
+        j: &StressSide,
+        g: &PairGeometry<L>,
+        acc: &mut [L; 3],
+    ) {
         // In 2-D the third row and column are zero: the loops stop at the dimension.
-        let dim = self.params.dim as usize;
         let rows = acc.iter_mut().zip(&i.tau_over_rho2).zip(&j.tau_over_rho2);
-        for ((a, t_i), t_j) in rows.take(dim) {
-            for ((&ti, &tj), x) in t_i.iter().zip(t_j).zip(g.x_ij).take(dim) {
+        for ((a, t_i), t_j) in rows.take(D) {
+            for ((&ti, &tj), x) in t_i.iter().zip(t_j).zip(g.x_ij).take(D) {
                 *a = L::select(g.valid, *a + g.m_j * (ti + L::splat(tj)) * x * g.f, *a);
             }
         }
