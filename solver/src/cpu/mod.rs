@@ -318,10 +318,10 @@ impl Engine for CpuEngine {
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {
         let (grid, b) = self.sorted();
-        let (mut forces, dt_limit) = self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), None);
+        let mut pass = self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), None);
         // Parked particles feel nothing.
-        forces.resize(b.ids.len(), [0.0; 4]);
-        Ok((by_id(&forces, &b.ids), forces::min_dt(&dt_limit)))
+        pass.forces.resize(b.ids.len(), [0.0; 4]);
+        Ok((by_id(&pass.forces, &b.ids), forces::min_dt(&pass.dt_limit)))
     }
 
     fn cell_list(&self) -> Result<(Vec<u32>, Vec<u32>), SolverError> {

@@ -13,12 +13,28 @@ use crate::contract::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, bed_wall, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
-use crate::physics::sediment::pass::REGION_HELD;
 use crate::physics::sediment::pass::{Draws, NO_FLUX, NO_TARGET, ParticleRheology};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
 use std::time::Instant;
+
+/// What a force pass leaves the integrator, for each active particle (sorted order).
+#[derive(Default)]
+pub(super) struct ForcePass {
+    pub forces: Vec<[f32; 4]>,
+    /// The stable step each particle allows.
+    pub dt_limit: Vec<f32>,
+    /// Whether its rheology pass held the particle; empty without the multiphase model.
+    held: Vec<bool>,
+}
+
+impl ForcePass {
+    /// Whether active particle `i` is held.
+    fn held(&self, i: usize) -> bool {
+        self.held.get(i).is_some_and(|&h| h)
+    }
+}
 
 impl CpuEngine {
     /// Sorts the state into cells: the sorted copy and its grid.
@@ -26,14 +42,6 @@ impl CpuEngine {
         let mut grid = self.grid();
         let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
         (grid, self.a.gather(&order))
-    }
-
-    /// Whether each mobile particle of `b` (sorted order) is held by the last rheology pass.
-    fn holds(&self, b: &State) -> Vec<bool> {
-        let words = b.positions.iter().zip(&b.ids);
-        words
-            .map(|(x, &id)| self.word(x, id) & REGION_HELD != 0)
-            .collect()
     }
 
     /// The region word the last rheology pass left each mobile particle of `b` (sorted
@@ -58,10 +66,12 @@ impl CpuEngine {
         b: &State,
         (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
         draws: Option<Draws>,
-    ) -> (Vec<[f32; 4]>, Vec<f32>) {
+    ) -> ForcePass {
         let active = grid.active() as usize;
         let start = Instant::now();
         let rheology = self.rheology(grid, b, (pos, vel), draws);
+        // Read from the pass rather than from the words it stored by id: the same flags.
+        let held = (rheology.iter().flatten()).map(|r| r.held).collect();
         self.timed(STAGE_RHEOLOGY, start);
         let start = Instant::now();
         let model = PairModel::new(&self.model);
@@ -131,7 +141,11 @@ impl CpuEngine {
             self.lanes.evaluated += lanes.evaluated;
             self.lanes.useful += lanes.useful;
         }
-        (forces, dt_limit)
+        ForcePass {
+            forces,
+            dt_limit,
+            held,
+        }
     }
 
     /// The rheology (and release) of the active particles of `b`, None without the
@@ -160,38 +174,40 @@ impl CpuEngine {
         let pass = rheology_pass(pool, params, model, grid, pos, vel, &holds, release);
         self.count(STAGE_RHEOLOGY, active, pass.asleep);
         self.walk_seconds[STAGE_RHEOLOGY] += pass.walk_s;
-        for (r, &id) in pass.out.iter().zip(&b.ids) {
-            self.regions[id as usize] = r.word();
-        }
-        // Parked particles are out of the flow: no region.
-        for &id in &b.ids[active..] {
-            self.regions[id as usize] = 0;
-        }
-        // The bed load of the pass that wore the bed, which the next one settles downstream.
+        // One loop over the ids, not one for each store: these are serial, and the ids
+        // random.
         let exner = self.sediment.as_ref().is_some_and(|m| m.exner());
-        if exner {
-            for (r, &id) in pass.out.iter().zip(&b.ids) {
-                self.bed_tops[id as usize] = bed_top_of(r);
+        let records = !pass.records.is_empty();
+        let wears = draws.is_some() && exner;
+        for (k, (r, &id)) in pass.out.iter().zip(&b.ids).enumerate() {
+            let id = id as usize;
+            self.regions[id] = r.word();
+            // The bed load of the pass that wore the bed, which the next one settles
+            // downstream.
+            if exner {
+                self.bed_tops[id] = bed_top_of(r);
             }
-            for &id in &b.ids[active..] {
-                self.bed_tops[id as usize] = BED_UNKNOWN;
+            // A held grain under the water sleeps by its last walk's record
+            // (`multiphase::deep`).
+            if records {
+                self.records[id] = pass.records[k];
+            }
+            if wears {
+                self.fluxes[id] = (r.flux, r.target);
             }
         }
-        // A held grain under the water sleeps by its last walk's record (`multiphase::deep`).
-        if !pass.records.is_empty() {
-            for (&r, &id) in pass.records.iter().zip(&b.ids) {
-                self.records[id as usize] = r;
+        // Parked particles are out of the flow: no region, no walk, no load.
+        for &id in &b.ids[active..] {
+            let id = id as usize;
+            self.regions[id] = 0;
+            if exner {
+                self.bed_tops[id] = BED_UNKNOWN;
             }
-            for &id in &b.ids[active..] {
-                self.records[id as usize] = f32::NAN;
+            if records {
+                self.records[id] = f32::NAN;
             }
-        }
-        if draws.is_some() && exner {
-            for (r, &id) in pass.out.iter().zip(&b.ids) {
-                self.fluxes[id as usize] = (r.flux, r.target);
-            }
-            for &id in &b.ids[active..] {
-                self.fluxes[id as usize] = (NO_FLUX, NO_TARGET);
+            if wears {
+                self.fluxes[id] = (NO_FLUX, NO_TARGET);
             }
         }
         Some(pass.out)
@@ -203,17 +219,15 @@ impl CpuEngine {
         let start = Instant::now();
         let (grid, b) = self.sorted();
         self.timed(STAGE_SORT, start);
-        let mut forces = Vec::new();
+        let mut pass = ForcePass::default();
         if st.t_rel < st.t_target && st.status == 0 {
-            let dt_limit;
             // The pass before the step's size is chosen draws the pick-ups, one draw a step.
             let draws = Draws {
                 step: st.run_steps.wrapping_add(st.steps),
                 dt_s: st.dt_taken,
             };
-            (forces, dt_limit) =
-                self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), Some(draws));
-            let stable = f32::from_bits(st.dt_min_bits).min(min_dt(&dt_limit));
+            pass = self.force_pass(&grid, &b, (&b.positions, &b.vel_rho), Some(draws));
+            let stable = f32::from_bits(st.dt_min_bits).min(min_dt(&pass.dt_limit));
             st.dt_min_bits = stable.to_bits();
         }
         dt_update(&self.params, st);
@@ -222,31 +236,30 @@ impl CpuEngine {
         }
         if self.shape.verlet {
             let start = Instant::now();
-            self.verlet(st, b, &forces);
+            self.verlet(st, b, &pass);
             self.timed(STAGE_INTEGRATE, start);
         } else {
-            self.symplectic(st, &grid, b, &forces);
+            self.symplectic(st, &grid, b, &pass);
         }
         st.status == 0
     }
 
-    fn verlet(&mut self, st: &mut StepState, b: State, forces: &[[f32; 4]]) {
+    fn verlet(&mut self, st: &mut StepState, b: State, pass: &ForcePass) {
         // dt_update has counted this step already.
         let euler = (st.step_base + st.steps - 1).is_multiple_of(self.params.euler_every.max(1));
         let (dt, dt_prev) = (st.dt, st.dt_prev);
         let store = Store::new(&self.params, &self.model);
-        let holds = self.holds(&b);
         let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
         let (next, held_parked) = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-            let Some(f) = forces.get(i) else {
+            let Some(f) = pass.forces.get(i) else {
                 // Parked: out of the flow.
                 return ((*x, *v), *v, Event::default());
             };
-            let held = holds[i];
+            let held = pass.held(i);
             let phase = store.phase(x);
-            let moved = if bed_walls && holds[i] {
+            let moved = if bed_walls && held {
                 bed_wall(phase, x, f)
             } else {
                 verlet_step(phase, dt, dt_prev, euler, x, v, &b.vel_rho_prev[i], f)
@@ -260,49 +273,49 @@ impl CpuEngine {
         self.forget_records(held_parked);
     }
 
-    fn symplectic(&mut self, st: &mut StepState, grid: &Grid, b: State, forces: &[[f32; 4]]) {
+    fn symplectic(&mut self, st: &mut StepState, grid: &Grid, b: State, pass: &ForcePass) {
         let start = Instant::now();
         let dt = st.dt;
         let store = Store::new(&self.params, &self.model);
-        let holds = self.holds(&b);
         let bed_walls = self.bed_is_boundary();
         let half: Vec<Particle> = self.pool.install(|| {
             (0..b.ids.len())
                 .into_par_iter()
                 .map(|i| {
                     let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-                    let Some(f) = forces.get(i) else {
+                    let Some(f) = pass.forces.get(i) else {
                         return (*x, *v);
                     };
-                    let free = if bed_walls && holds[i] {
+                    let held = pass.held(i);
+                    let free = if bed_walls && held {
                         bed_wall(store.phase(x), x, f)
                     } else {
                         predict(store.phase(x), dt, x, v, f)
                     };
-                    store.half_step(x, v, holds[i], 0.5 * dt, free)
+                    store.half_step(x, v, held, 0.5 * dt, free)
                 })
                 .collect()
         });
         let (x_half, v_half): (Vec<[f32; 4]>, Vec<[f32; 4]>) = half.into_iter().unzip();
         self.timed(STAGE_INTEGRATE, start);
-        let (forces_half, _) = self.force_pass(grid, &b, (&x_half, &v_half), None);
+        // The corrector's rheology pass sets the holds again.
+        let half = self.force_pass(grid, &b, (&x_half, &v_half), None);
         let start = Instant::now();
         let store = Store::new(&self.params, &self.model);
-        // The corrector's rheology pass has set the holds again.
-        let holds = self.holds(&b);
         let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
         let (next, held_parked) = Self::store_all(&self.pool, st, buffers, |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
-            let Some(f) = forces_half.get(i) else {
+            let Some(f) = half.forces.get(i) else {
                 return ((*x, *v), b.vel_rho_prev[i], Event::default());
             };
-            let moved = if bed_walls && holds[i] {
+            let held = half.held(i);
+            let moved = if bed_walls && held {
                 bed_wall(store.phase(x), x, f)
             } else {
                 correct(store.phase(x), dt, x, v, v_half[i][3], f)
             };
-            let (out, event) = store.apply(b.ids[i], x, v, holds[i], dt, moved);
+            let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
             (out, b.vel_rho_prev[i], event)
         });
         self.a = State { ids: b.ids, ..next };
