@@ -256,24 +256,30 @@ impl Pass<'_> {
             let mine = StressSide::lanes(&m.map(|i| stress[i]));
             (div, stress, mine)
         });
-        grid.group_cells(
-            group,
-            #[inline(always)]
-            |range, near| match &stress {
-                None => {
+        // One walk for each model, not one choice per cell: the stress's sums would otherwise
+        // stay live through the water-only walk and crowd its registers.
+        match &stress {
+            None => grid.group_cells(
+                group,
+                #[inline(always)]
+                |range, near| {
                     for j in range {
                         model.add_pair(&side, &sides[j], near, &mut sum);
                     }
-                }
-                Some((div, stress, stress_i)) => {
+                },
+            ),
+            Some((div, stress, stress_i)) => grid.group_cells(
+                group,
+                #[inline(always)]
+                |range, near| {
                     for j in range {
                         if let Some(g) = model.add_pair(&side, &sides[j], near, &mut sum) {
                             div.add_term(stress_i, &stress[j], &g, &mut tau);
                         }
                     }
-                }
-            },
-        );
+                },
+            ),
+        }
         (sum, tau)
     }
 
