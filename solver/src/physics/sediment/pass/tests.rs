@@ -489,3 +489,28 @@ fn a_grain_alone_on_the_bed_is_not_held_and_one_in_a_row_is() {
     // A wall beside it holds it as a grain would.
     assert!(grain_on_the_bed_is_held(&[([0.01, 0.01], 0)], false));
 }
+
+/// In 3-D the velocity gradient counts the third axis (Eq. 13: `V_j (u_j - u_i)_a (grad_i
+/// W)_b`, with `grad_i W = x_ij F(r)`): a water neighbour straight below in z, moving along x
+/// and z, gives `grad[0][2]` and `grad[2][2]` and nothing else. A pair that stopped at two
+/// dimensions gives zero for both.
+#[test]
+fn the_velocity_gradient_counts_the_third_axis_in_3d() {
+    let (mut params, model) = flume_case();
+    params.dim = 3;
+    params.gravity = [0.0, 0.0, -9.81];
+    let pass = Rheology::new(&params, &model);
+    let water = f32::from_bits(1);
+    let (x_i, v_i) = ([0.0, 0.0, 0.0, water], [0.0, 0.0, 0.0, 1000.0]);
+    let (x_j, v_j) = ([0.0, 0.0, -0.01, water], [0.3, 0.0, 0.2, 1000.0]);
+    let mut s = pass.start(&x_i, &v_i);
+    pass.add_pair((&x_i, &v_i), (&x_j, &v_j), &mut s);
+    let f = crate::physics::kernel::grad_factor(0.01, params.h, 3);
+    let vol = pass.volume(&x_j, &v_j);
+    let close = |got: f32, want: f32| (got - want).abs() <= 1e-6 * want.abs();
+    assert!(close(s.grad[0][2], vol * 0.3 * 0.01 * f), "{:?}", s.grad);
+    assert!(close(s.grad[2][2], vol * 0.2 * 0.01 * f), "{:?}", s.grad);
+    for (a, b) in [(0, 0), (0, 1), (1, 0), (1, 1), (1, 2), (2, 0), (2, 1)] {
+        assert_eq!(s.grad[a][b], 0.0, "grad[{a}][{b}] of {:?}", s.grad);
+    }
+}
