@@ -74,14 +74,14 @@ impl State {
     /// parallel region for the four arrays, not four: each wakes the pool's threads. Each
     /// chunk writes its slots in place: collecting the four as a tuple goes through rayon's
     /// `unzip`, which joins the threads' pieces on one thread (README, speed).
-    fn gather(&self, order: &[u32]) -> State {
+    /// The buffers of `b` are reused: every slot is written, so only the ones a longer order
+    /// adds are set first.
+    fn gather(&self, order: &[u32], mut b: State) -> State {
         let n = order.len();
-        let mut b = State {
-            positions: vec![[0.0; 4]; n],
-            vel_rho: vec![[0.0; 4]; n],
-            ids: vec![0; n],
-            vel_rho_prev: vec![[0.0; 4]; n],
-        };
+        b.positions.resize(n, [0.0; 4]);
+        b.vel_rho.resize(n, [0.0; 4]);
+        b.ids.resize(n, 0);
+        b.vel_rho_prev.resize(n, [0.0; 4]);
         let chunk = grid::PAR_MIN;
         let motion = b
             .positions
@@ -120,6 +120,11 @@ pub struct CpuEngine {
     /// The sediment model, None without the multiphase viscosity.
     sediment: Option<SedimentModel>,
     a: State,
+    /// The buffers of the last step's sorted copy, which the next sort fills (`step.rs`):
+    /// writing into memory a step has just used spares the allocator's zeroing of fresh
+    /// memory.
+    spare: State,
+    side_buffers: step::SideBuffers,
     /// Region words by id (region | REGION_HELD), as the last rheology pass left them.
     regions: Vec<u32>,
     /// The bed load each held particle at the surface passed on in the last pass that drew
@@ -191,6 +196,8 @@ impl CpuEngine {
                 records: records.clone(),
             },
             a,
+            spare: State::default(),
+            side_buffers: step::SideBuffers::default(),
             regions,
             fluxes,
             bed_tops,

@@ -19,6 +19,19 @@ use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
 use std::time::Instant;
 
+/// Particles per block handed to a thread in the passes over each particle.
+const BLOCK: usize = 64;
+
+/// The force pass's sides of each active particle, kept from one pass to the next: filling
+/// memory a pass has just used spares the allocator's zeroing of fresh memory.
+#[derive(Default)]
+pub(super) struct SideBuffers {
+    sides: Vec<Side>,
+    imposed: Vec<bool>,
+    stress: Vec<StressSide>,
+    mu: Vec<f32>,
+}
+
 /// What a force pass leaves the integrator, for each active particle (sorted order).
 #[derive(Default)]
 pub(super) struct ForcePass {
@@ -39,9 +52,14 @@ impl ForcePass {
 impl CpuEngine {
     /// Sorts the state into cells: the sorted copy and its grid.
     pub(super) fn sorted(&self) -> (Grid, State) {
+        self.sorted_into(State::default())
+    }
+
+    /// [`CpuEngine::sorted`] into the buffers of `spare`.
+    fn sorted_into(&self, spare: State) -> (Grid, State) {
         let mut grid = self.grid();
         let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
-        (grid, self.a.gather(&order))
+        (grid, self.a.gather(&order, spare))
     }
 
     /// The region word the last rheology pass left each mobile particle of `b` (sorted
@@ -75,49 +93,28 @@ impl CpuEngine {
         self.timed(STAGE_RHEOLOGY, start);
         let start = Instant::now();
         let model = PairModel::new(&self.model);
-        let store = Store::new(&self.params, &self.model);
-        let bed_walls = self.bed_is_boundary();
-        let shields_only = self.params.sediment.shields_only != 0;
         let div = StressDivergence::new(&self.model);
-        let side_of = |i: usize| {
-            let imposed = store.velocity_imposed(&pos[i]);
-            let side = model.side(&pos[i], &vel[i]);
-            // The Shields-only mode's held bed stands as a wall does (`physics::boundary`), or
-            // is fixed where it stands.
-            let held = rheology.as_ref().is_some_and(|r| r[i].held);
-            let side = Side {
-                imposed,
-                mobile: side.mobile && !(bed_walls && held),
-                fixed: side.mobile && held && !bed_walls && shields_only,
-                ..side
-            };
-            (side, imposed)
-        };
-        type Stress = (Vec<StressSide>, Vec<f32>);
-        // The stress sides in the same parallel region as the pair sides: a region costs a
-        // step more than its work at CI size (README, speed).
-        let ((sides, imposed), stress): ((Vec<Side>, Vec<bool>), Option<Stress>) =
-            self.pool.install(|| match &rheology {
-                None => ((0..active).into_par_iter().map(side_of).unzip(), None),
-                Some(r) => {
-                    let (sides, stress) = (0..active)
-                        .into_par_iter()
-                        .map(|i| {
-                            let stress = (div.side(&pos[i], vel[i][3], &r[i].stress), r[i].mu);
-                            (side_of(i), stress)
-                        })
-                        .unzip();
-                    (sides, Some(stress))
-                }
-            });
+        let mut buffers = std::mem::take(&mut self.side_buffers);
+        let rheology_out = rheology.as_deref();
+        self.fill_sides(
+            &mut buffers,
+            (&model, &div),
+            (active, pos, vel),
+            rheology_out,
+        );
+        let multiphase = rheology.is_some();
+        let SideBuffers {
+            sides,
+            imposed,
+            stress,
+            mu,
+        } = &buffers;
         let mobile = self
             .awake_set
             .then(|| Flagged::new(active, |k| sides[k].mobile));
         let extra = Extra {
-            stress: stress
-                .as_ref()
-                .map(|(s, mu)| (&div, s.as_slice(), mu.as_slice())),
-            imposed: &imposed,
+            stress: multiphase.then_some((&div, stress.as_slice(), mu.as_slice())),
+            imposed,
             mobile: mobile.as_ref(),
         };
         let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
@@ -126,7 +123,7 @@ impl CpuEngine {
             &self.pool,
             &model,
             grid,
-            &sides,
+            sides,
             &extra,
             &mut forces,
             &mut dt_limit,
@@ -134,18 +131,90 @@ impl CpuEngine {
         self.walk_seconds[STAGE_FORCES] += walk.elapsed().as_secs_f64();
         let lanes = self
             .count_lanes
-            .then(|| lane_use(&self.pool, &model, grid, &sides, &extra));
+            .then(|| lane_use(&self.pool, &model, grid, sides, &extra));
         self.count(STAGE_FORCES, active, asleep);
         self.timed(STAGE_FORCES, start);
         if let Some(lanes) = lanes {
             self.lanes.evaluated += lanes.evaluated;
             self.lanes.useful += lanes.useful;
         }
+        self.side_buffers = buffers;
         ForcePass {
             forces,
             dt_limit,
             held,
         }
+    }
+
+    /// Fills `buffers` with the sides of the first `active` particles at `pos`, `vel` (sorted
+    /// order) as the force pass's pairs see them: with the holds and stresses of their
+    /// `rheology`, if the model has one. The stress sides go in the same parallel region as
+    /// the pair sides: a region costs a step more than its work at CI size (README, speed).
+    /// Each block writes its slots in place: an `unzip` joins the threads' pieces on one
+    /// thread.
+    fn fill_sides(
+        &self,
+        buffers: &mut SideBuffers,
+        (model, div): (&PairModel, &StressDivergence),
+        (active, pos, vel): (usize, &[[f32; 4]], &[[f32; 4]]),
+        rheology: Option<&[ParticleRheology]>,
+    ) {
+        let store = Store::new(&self.params, &self.model);
+        let bed_walls = self.bed_is_boundary();
+        let shields_only = self.params.sediment.shields_only != 0;
+        let side_of = |i: usize| {
+            let imposed = store.velocity_imposed(&pos[i]);
+            let side = model.side(&pos[i], &vel[i]);
+            // The Shields-only mode's held bed stands as a wall does (`physics::boundary`), or
+            // is fixed where it stands.
+            let held = rheology.is_some_and(|r| r[i].held);
+            let side = Side {
+                imposed,
+                mobile: side.mobile && !(bed_walls && held),
+                fixed: side.mobile && held && !bed_walls && shields_only,
+                ..side
+            };
+            (side, imposed)
+        };
+        let SideBuffers {
+            sides,
+            imposed,
+            stress,
+            mu,
+        } = buffers;
+        sides.resize(active, Side::default());
+        imposed.resize(active, false);
+        stress.resize(
+            if rheology.is_some() { active } else { 0 },
+            StressSide::default(),
+        );
+        mu.resize(stress.len(), 0.0);
+        let pair_sides = |b: usize, sides: &mut [Side], imposed: &mut [bool]| {
+            for (k, i) in (b * BLOCK..).take(sides.len()).enumerate() {
+                (sides[k], imposed[k]) = side_of(i);
+            }
+        };
+        self.pool.install(|| {
+            let own = sides
+                .par_chunks_mut(BLOCK)
+                .zip(imposed.par_chunks_mut(BLOCK));
+            match rheology {
+                None => own
+                    .enumerate()
+                    .for_each(|(b, (sides, imposed))| pair_sides(b, sides, imposed)),
+                Some(r) => {
+                    let theirs = stress.par_chunks_mut(BLOCK).zip(mu.par_chunks_mut(BLOCK));
+                    let blocks = own.zip(theirs).enumerate();
+                    blocks.for_each(|(b, ((sides, imposed), (stress, mu)))| {
+                        pair_sides(b, sides, imposed);
+                        for (k, i) in (b * BLOCK..).take(stress.len()).enumerate() {
+                            stress[k] = div.side(&pos[i], vel[i][3], &r[i].stress);
+                            mu[k] = r[i].mu;
+                        }
+                    });
+                }
+            }
+        });
     }
 
     /// The rheology (and release) of the active particles of `b`, None without the
@@ -217,7 +286,8 @@ impl CpuEngine {
     /// raised), as the GPU's idle steps past the end of a chunk.
     pub(super) fn step(&mut self, st: &mut StepState) -> bool {
         let start = Instant::now();
-        let (grid, b) = self.sorted();
+        let spare = std::mem::take(&mut self.spare);
+        let (grid, b) = self.sorted_into(spare);
         self.timed(STAGE_SORT, start);
         let mut pass = ForcePass::default();
         if st.t_rel < st.t_target && st.status == 0 {
@@ -269,7 +339,7 @@ impl CpuEngine {
             let prev = if held { [0.0, 0.0, 0.0, v[3]] } else { *v };
             (out, prev, event)
         });
-        self.a = State { ids: b.ids, ..next };
+        self.a_after(b, next);
         self.forget_records(held_parked);
     }
 
@@ -318,7 +388,7 @@ impl CpuEngine {
             let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
             (out, b.vel_rho_prev[i], event)
         });
-        self.a = State { ids: b.ids, ..next };
+        self.a_after(b, next);
         self.forget_records(held_parked);
         self.timed(STAGE_INTEGRATE, start);
     }
@@ -355,6 +425,13 @@ impl CpuEngine {
         });
         tally(st, &events);
         (next, events.iter().any(|e| e.held_parked))
+    }
+
+    /// Makes `next` (with the ids of `b`, whose order it was stored in) the state, and keeps
+    /// what is left of both as the next sort's buffers.
+    fn a_after(&mut self, b: State, next: State) {
+        self.spare = State { ids: next.ids, ..b };
+        self.a = State { ids: b.ids, ..next };
     }
 
     /// After a held grain was parked, no record bounds a kernel mass it was in

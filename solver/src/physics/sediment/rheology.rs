@@ -123,7 +123,14 @@ pub fn hbp_viscosity(ii_d: f32, tau_c: f32, m: f32, n: f32, mu_s: f32) -> f32 {
     let ii_d = ii_d.max(0.0);
     let s = ii_d.sqrt();
     let yield_term = tau_c * m * papanastasiou_factor(m * s);
-    let power_term = 2.0 * mu_s * (4.0 * ii_d).powf(0.5 * (n - 1.0));
+    // x^0 is 1 for every x (IEEE 754's pow, NaN included): the Newtonian power law spares
+    // the call into libm, to the same bits.
+    let power = if n == 1.0 {
+        1.0
+    } else {
+        (4.0 * ii_d).powf(0.5 * (n - 1.0))
+    };
+    let power_term = 2.0 * mu_s * power;
     yield_term + power_term
 }
 
