@@ -355,6 +355,14 @@ mod tests {
         })
     }
 
+    /// A 24-bit pseudo-random sequence (Numerical Recipes' LCG, its top bits) from `seed`.
+    fn lcg(mut seed: u32) -> impl FnMut() -> u32 {
+        move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            seed >> 8
+        }
+    }
+
     /// A 2-D grid of 12 x 9 cells of h = 1.7 dp at dp = 0.01 (two divisions of 2h, as the
     /// CI flume has), and its cell size.
     fn twelve_by_nine() -> (Grid, f32) {
@@ -404,11 +412,7 @@ mod tests {
     #[test]
     fn the_sort_is_by_cell_then_id_from_any_storage_order() {
         let (mut grid, cell) = twelve_by_nine();
-        let mut seed = 5u32;
-        let mut next = || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            seed >> 8
-        };
+        let mut next = lcg(5);
         let n = 400;
         let mut pos: Vec<[f32; 4]> = (0..n)
             .map(|_| {
@@ -445,11 +449,8 @@ mod tests {
     fn a_box_s_rows_hold_every_particle_in_it() {
         let (mut grid, cell) = twelve_by_nine();
         // A lattice of dp = 0.01 shaken by up to 0.4 dp, some of it outside the grid.
-        let mut seed = 11u32;
-        let mut shake = || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / 16_777_216.0 - 0.5
-        };
+        let mut next = lcg(11);
+        let mut shake = || next() as f32 / 16_777_216.0 - 0.5;
         let mut pos = Vec::new();
         for iy in 0..16 {
             for ix in 0..22 {

@@ -372,3 +372,36 @@ impl Engine for CpuEngine {
         self.count_lanes = on;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::State;
+    use super::grid::gather;
+
+    /// Gathered into the buffers of an earlier copy, longer or shorter and holding other
+    /// values, the state is what a gather slot by slot gives, every array the order's length.
+    #[test]
+    fn a_gather_into_used_buffers_is_a_fresh_one() {
+        let n = 3000;
+        let a = State {
+            positions: (0..n).map(|k| [k as f32, 1.0, 2.0, 0.0]).collect(),
+            vel_rho: (0..n).map(|k| [0.5, k as f32, 0.0, 1000.0]).collect(),
+            ids: (0..n as u32).map(|k| (k * 7) % n as u32).collect(),
+            vel_rho_prev: (0..n).map(|k| [0.0, 0.0, k as f32, 999.0]).collect(),
+        };
+        let order: Vec<u32> = (0..n as u32).map(|k| (k * 1237) % n as u32).collect();
+        let junk = |len: usize| State {
+            positions: vec![[-1.0; 4]; len],
+            vel_rho: vec![[-2.0; 4]; len],
+            ids: vec![u32::MAX; len],
+            vel_rho_prev: vec![[-3.0; 4]; len],
+        };
+        for spare in [State::default(), junk(n + 500), junk(n / 3)] {
+            let b = a.gather(&order, spare);
+            assert_eq!(b.positions, gather(&a.positions, &order));
+            assert_eq!(b.vel_rho, gather(&a.vel_rho, &order));
+            assert_eq!(b.ids, gather(&a.ids, &order));
+            assert_eq!(b.vel_rho_prev, gather(&a.vel_rho_prev, &order));
+        }
+    }
+}

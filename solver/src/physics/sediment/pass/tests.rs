@@ -514,3 +514,29 @@ fn the_velocity_gradient_counts_the_third_axis_in_3d() {
         assert_eq!(s.grad[a][b], 0.0, "grad[{a}][{b}] of {:?}", s.grad);
     }
 }
+
+/// In 3-D the stress divergence counts the third axis: `m_j (tau_i / rho_i^2 + tau_j /
+/// rho_j^2)_ab (grad_i W)_b` with `grad_i W = x_ij F(r)`, for a water neighbour straight below
+/// in z whose stress has xz and zz parts, gives x and z accelerations and no y. A term that
+/// stopped at two dimensions gives zero for both.
+#[test]
+fn the_stress_divergence_counts_the_third_axis_in_3d() {
+    use crate::physics::sediment::stress::StressDivergence;
+    let (mut params, _) = flume_case();
+    params.dim = 3;
+    params.gravity = [0.0, 0.0, -9.81];
+    let (dp, rho, water) = (0.01, 1000.0, f32::from_bits(1));
+    let div = StressDivergence::new(&params);
+    let mut tau_j = [[0.0_f32; 3]; 3];
+    (tau_j[0][2], tau_j[2][0], tau_j[2][2]) = (2.0, 2.0, 3.0);
+    let i = div.side(&[0.0, 0.0, 0.0, water], rho, &[[0.0; 3]; 3]);
+    let j = div.side(&[0.0, 0.0, -dp, water], rho, &tau_j);
+    let mut acc = [0.0_f32; 3];
+    div.add_pair(&i, &j, &mut acc);
+    let mass = params.phases[1].mass;
+    let per_stress = mass / (rho * rho) * dp * crate::physics::kernel::grad_factor(dp, params.h, 3);
+    let close = |got: f32, want: f32| (got - want).abs() <= 1e-5 * want.abs();
+    assert!(close(acc[0], 2.0 * per_stress), "{acc:?}");
+    assert!(close(acc[2], 3.0 * per_stress), "{acc:?}");
+    assert_eq!(acc[1], 0.0);
+}
