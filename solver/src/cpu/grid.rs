@@ -326,6 +326,11 @@ impl Flagged {
         }
         Flagged { before }
     }
+
+    /// Whether no particle is flagged.
+    pub fn is_empty(&self) -> bool {
+        self.before.last().is_none_or(|&n| n == 0)
+    }
 }
 
 /// `values` in sorted order: slot k holds the value of storage index `order[k]`.

@@ -172,7 +172,8 @@ pub fn rheology_pass(
     });
     let walk_s = walk.elapsed().as_secs_f64();
     if release {
-        release_held(pool, (params, model), grid, (pos, vel), &mut out);
+        let awake = holds.awake_set;
+        release_held(pool, (params, model), grid, (pos, vel), awake, &mut out);
     }
     if sleepers.deep.is_none() {
         records.clear();
@@ -255,15 +256,23 @@ impl<'a> Sleepers<'a> {
 }
 
 /// Releases the held sediment whose neighbours transmit enough stress (`hold.wgsl`), from the
-/// regions `out` the rheology pass left, before any release.
+/// regions `out` the rheology pass left, before any release. With the awake set a held grain
+/// with no moving sediment in the cells within reach is not walked: its sums would stay empty,
+/// which releases nothing, the value the walk gives (`tests/awake_set.rs`); with none moving
+/// anywhere, none is.
 fn release_held(
     pool: &rayon::ThreadPool,
     (params, model): (&Params, &SedimentModel),
     grid: &Grid,
     (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+    awake_set: bool,
     out: &mut [ParticleRheology],
 ) {
     let stage = Release::new(params, model);
+    let moving = awake_set.then(|| Flagged::new(out.len(), |k| stage.transmits(&pos[k], &out[k])));
+    if moving.as_ref().is_some_and(Flagged::is_empty) {
+        return;
+    }
     let released: Vec<bool> = pool.install(|| {
         (0..out.len())
             .into_par_iter()
@@ -271,8 +280,12 @@ fn release_held(
                 if !stage.applies(&pos[i], &out[i]) {
                     return false;
                 }
+                let x = [pos[i][0], pos[i][1], pos[i][2]];
+                if moving.as_ref().is_some_and(|m| !grid.any_near(m, &x)) {
+                    return false;
+                }
                 let mut sums = Transmitted::default();
-                grid.rows(grid.coords(&[pos[i][0], pos[i][1], pos[i][2]]), |range| {
+                grid.rows(grid.coords(&x), |range| {
                     for j in range {
                         stage.add_pair(&pos[i], (&pos[j], &vel[j], &out[j]), &mut sums);
                     }

@@ -142,6 +142,13 @@ impl<'a> Release<'a> {
         if self.model.exner() { units } else { 0 }
     }
 
+    /// Whether particle `x` of this rheology transmits stress to the held sediment around it:
+    /// moving sediment.
+    #[inline(always)]
+    pub fn transmits(&self, x: &[f32; 4], rheology: &ParticleRheology) -> bool {
+        !rheology.held && phase_index(x) == self.model.sediment_phase
+    }
+
     /// Adds neighbour j (position, velocity-density, rheology) to a held particle at `x_i`:
     /// only moving sediment within the support counts.
     #[inline(always)]
@@ -151,7 +158,7 @@ impl<'a> Release<'a> {
         (x_j, v_j, r_j): (&[f32; 4], &[f32; 4], &ParticleRheology),
         sums: &mut Transmitted,
     ) {
-        if r_j.held || phase_index(x_j) != self.model.sediment_phase {
+        if !self.transmits(x_j, r_j) {
             return;
         }
         let r2: f32 = (0..3).map(|k| (x_i[k] - x_j[k]).powi(2)).sum();
