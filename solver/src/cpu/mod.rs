@@ -8,6 +8,7 @@
 //! its holds, and the open flume. An open flume's parked particles sort after every cell and
 //! take no part in the neighbour passes or the integrators.
 
+mod by_id;
 #[cfg(test)]
 mod fixture;
 mod forces;
@@ -25,8 +26,9 @@ use crate::engine::{PipelineShape, by_id};
 use crate::error::SolverError;
 use crate::particles::Particles;
 use crate::physics;
-use crate::physics::sediment::pass::{NO_FLUX, NO_TARGET, SedimentModel};
+use crate::physics::sediment::pass::SedimentModel;
 use crate::physics::sediment::suspension::Region;
+use by_id::ById;
 use grid::Grid;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -63,10 +65,7 @@ struct State {
 /// What a blow-up rolls back to (`Engine::save`, `Engine::restore`).
 struct Snapshot {
     a: State,
-    regions: Vec<u32>,
-    fluxes: Vec<(f32, u32)>,
-    bed_tops: Vec<u8>,
-    records: Vec<f32>,
+    by_id: ById,
 }
 
 impl State {
@@ -125,17 +124,8 @@ pub struct CpuEngine {
     /// memory.
     spare: State,
     side_buffers: step::SideBuffers,
-    /// Region words by id (region | REGION_HELD), as the last rheology pass left them.
-    regions: Vec<u32>,
-    /// The bed load each held particle at the surface passed on in the last pass that drew
-    /// (`van_rijn_exner`), and the id it passed it to, by id; `NO_FLUX` for any other.
-    fluxes: Vec<(f32, u32)>,
-    /// Under `van_rijn_exner`, where each particle's last walk found it on the bed, by id
-    /// (`multiphase::Holds::bed_tops`).
-    bed_tops: Vec<u8>,
-    /// What each held grain's last walk bounds its kernel mass by, by id (NaN: none;
-    /// `multiphase::Holds::records`).
-    records: Vec<f32>,
+    /// What the rheology passes leave each particle for the next, by id.
+    by_id: ById,
     snapshot: Snapshot,
     probe_points: Vec<[f32; 4]>,
     /// Seconds spent in each of `STAGES`, and of them in its walk (`StageTime::walk_seconds`).
@@ -177,10 +167,7 @@ impl CpuEngine {
             ids: particles.ids.clone(),
             vel_rho_prev: particles.vel_rho.clone(),
         };
-        let regions = vec![0; particles.len()];
-        let fluxes = vec![(NO_FLUX, NO_TARGET); particles.len()];
-        let bed_tops = vec![multiphase::BED_UNKNOWN; particles.len()];
-        let records = vec![f32::NAN; particles.len()];
+        let by_id = ById::new(particles.len());
         Ok(CpuEngine {
             threads: pool.current_num_threads(),
             pool: Arc::new(pool),
@@ -190,18 +177,12 @@ impl CpuEngine {
             sediment: sediment.filter(|_| params.viscosity_mode == VISCOSITY_MULTIPHASE),
             snapshot: Snapshot {
                 a: a.clone(),
-                regions: regions.clone(),
-                fluxes: fluxes.clone(),
-                bed_tops: bed_tops.clone(),
-                records: records.clone(),
+                by_id: by_id.clone(),
             },
             a,
             spare: State::default(),
             side_buffers: step::SideBuffers::default(),
-            regions,
-            fluxes,
-            bed_tops,
-            records,
+            by_id,
             probe_points: probe_points.to_vec(),
             seconds: [0.0; STAGES.len()],
             walk_seconds: [0.0; STAGES.len()],
@@ -239,7 +220,7 @@ impl CpuEngine {
         let sediment = self.params.sediment.phase;
         sediment != 0
             && b.positions[k][3].to_bits() == sediment
-            && self.regions[b.ids[k] as usize] & 255 == Region::Unyielded as u32
+            && self.by_id.regions[b.ids[k] as usize] & 255 == Region::Unyielded as u32
     }
 }
 
@@ -256,19 +237,13 @@ impl Engine for CpuEngine {
     fn save(&mut self) {
         let s = &mut self.snapshot;
         s.a.clone_from(&self.a);
-        s.regions.clone_from(&self.regions);
-        s.fluxes.clone_from(&self.fluxes);
-        s.bed_tops.clone_from(&self.bed_tops);
-        s.records.clone_from(&self.records);
+        s.by_id.clone_from(&self.by_id);
     }
 
     fn restore(&mut self) {
         let s = &self.snapshot;
         self.a.clone_from(&s.a);
-        self.regions.clone_from(&s.regions);
-        self.fluxes.clone_from(&s.fluxes);
-        self.bed_tops.clone_from(&s.bed_tops);
-        self.records.clone_from(&s.records);
+        self.by_id.clone_from(&s.by_id);
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {
@@ -301,7 +276,7 @@ impl Engine for CpuEngine {
         self.a.vel_rho[slot] = vel_rho;
         self.a.vel_rho_prev[slot] = vel_rho;
         // A particle placed from outside has taken no walk where it now stands.
-        if let Some(r) = self.records.get_mut(self.a.ids[slot] as usize) {
+        if let Some(r) = self.by_id.records.get_mut(self.a.ids[slot] as usize) {
             *r = f32::NAN;
         }
     }
@@ -313,14 +288,14 @@ impl Engine for CpuEngine {
     }
 
     fn regions(&self) -> Result<Vec<u32>, SolverError> {
-        Ok(self.regions.clone())
+        Ok(self.by_id.regions.clone())
     }
 
     fn write_regions(&mut self, words: &[u32]) {
-        self.regions.copy_from_slice(words);
+        self.by_id.regions.copy_from_slice(words);
         // A word set from outside is no walk's: the grain walks before it may sleep.
-        self.bed_tops.fill(multiphase::BED_UNKNOWN);
-        self.records.fill(f32::NAN);
+        self.by_id.bed_tops.fill(multiphase::BED_UNKNOWN);
+        self.by_id.forget_records();
     }
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {

@@ -4,16 +4,17 @@
 //! are `physics::integrate`'s; `store.rs` ends each particle's step, and `dt_update` mirrors
 //! `dt_update.wgsl`.
 
+use super::by_id::Kept;
 use super::forces::{Extra, force_pass, lane_use, min_dt};
 use super::grid::{Flagged, Grid};
-use super::multiphase::{BED_UNKNOWN, Holds, bed_top_of, rheology_pass};
+use super::multiphase::{Holds, RheologyPass, rheology_pass};
 use super::store::{Event, Store, tally};
 use super::{CpuEngine, STAGE_FORCES, STAGE_INTEGRATE, STAGE_RHEOLOGY, STAGE_SORT, State};
 use crate::contract::{SimParams, StepState};
 use crate::health::Health;
 use crate::physics::integrate::{Particle, bed_wall, correct, predict, verlet_step};
 use crate::physics::interaction::{PairModel, Side};
-use crate::physics::sediment::pass::{Draws, NO_FLUX, NO_TARGET, ParticleRheology};
+use crate::physics::sediment::pass::{Draws, ParticleRheology};
 use crate::physics::sediment::stress::{StressDivergence, StressSide};
 use crate::physics::timestep::{NextStep, next_step};
 use rayon::prelude::*;
@@ -49,6 +50,77 @@ impl ForcePass {
     }
 }
 
+impl SideBuffers {
+    /// Fills the buffers with the sides of the first `active` particles at `pos`, `vel` (sorted
+    /// order) as the force pass's pairs see them: with the holds and stresses of their
+    /// `rheology`, if the model has one. The stress sides go in the same parallel region as
+    /// the pair sides: a region costs a step more than its work at CI size (README, speed).
+    /// Each block writes its slots in place: an `unzip` joins the threads' pieces on one
+    /// thread. Runs on the engine's pool.
+    fn fill(
+        &mut self,
+        (params, physics): (&SimParams, &crate::physics::Params),
+        (model, div): (&PairModel, &StressDivergence),
+        (active, pos, vel): (usize, &[[f32; 4]], &[[f32; 4]]),
+        rheology: Option<&[ParticleRheology]>,
+    ) {
+        let store = Store::new(params, physics);
+        let bed_walls = params.held_bed_is_wall();
+        let shields_only = params.sediment.shields_only != 0;
+        let side_of = |i: usize| {
+            let imposed = store.velocity_imposed(&pos[i]);
+            let side = model.side(&pos[i], &vel[i]);
+            // The Shields-only mode's held bed stands as a wall does (`physics::boundary`), or
+            // is fixed where it stands.
+            let held = rheology.is_some_and(|r| r[i].held);
+            let side = Side {
+                imposed,
+                mobile: side.mobile && !(bed_walls && held),
+                fixed: side.mobile && held && !bed_walls && shields_only,
+                ..side
+            };
+            (side, imposed)
+        };
+        let SideBuffers {
+            sides,
+            imposed,
+            stress,
+            mu,
+        } = self;
+        sides.resize(active, Side::default());
+        imposed.resize(active, false);
+        stress.resize(
+            if rheology.is_some() { active } else { 0 },
+            StressSide::default(),
+        );
+        mu.resize(stress.len(), 0.0);
+        let pair_sides = |b: usize, sides: &mut [Side], imposed: &mut [bool]| {
+            for (k, i) in (b * BLOCK..).take(sides.len()).enumerate() {
+                (sides[k], imposed[k]) = side_of(i);
+            }
+        };
+        let own = sides
+            .par_chunks_mut(BLOCK)
+            .zip(imposed.par_chunks_mut(BLOCK));
+        match rheology {
+            None => own
+                .enumerate()
+                .for_each(|(b, (sides, imposed))| pair_sides(b, sides, imposed)),
+            Some(r) => {
+                let theirs = stress.par_chunks_mut(BLOCK).zip(mu.par_chunks_mut(BLOCK));
+                let blocks = own.zip(theirs).enumerate();
+                blocks.for_each(|(b, ((sides, imposed), (stress, mu)))| {
+                    pair_sides(b, sides, imposed);
+                    for (k, i) in (b * BLOCK..).take(stress.len()).enumerate() {
+                        stress[k] = div.side(&pos[i], vel[i][3], &r[i].stress);
+                        mu[k] = r[i].mu;
+                    }
+                });
+            }
+        }
+    }
+}
+
 impl CpuEngine {
     /// Sorts the state into cells: the sorted copy and its grid.
     pub(super) fn sorted(&self) -> (Grid, State) {
@@ -73,7 +145,11 @@ impl CpuEngine {
     /// mobile, else 0.
     fn word(&self, x: &[f32; 4], id: u32) -> u32 {
         let mobile = self.model.phases[x[3].to_bits() as usize].mobile;
-        if mobile { self.regions[id as usize] } else { 0 }
+        if mobile {
+            self.by_id.regions[id as usize]
+        } else {
+            0
+        }
     }
 
     /// (Rheology and release, then) forces and stable steps of the active particles of `b`
@@ -88,20 +164,31 @@ impl CpuEngine {
         let active = grid.active() as usize;
         let start = Instant::now();
         let rheology = self.rheology(grid, b, (pos, vel), draws);
-        // Read from the pass rather than from the words it stored by id: the same flags.
-        let held = (rheology.iter().flatten()).map(|r| r.held).collect();
         self.timed(STAGE_RHEOLOGY, start);
         let start = Instant::now();
         let model = PairModel::new(&self.model);
         let div = StressDivergence::new(&self.model);
         let mut buffers = std::mem::take(&mut self.side_buffers);
-        let rheology_out = rheology.as_deref();
-        self.fill_sides(
-            &mut buffers,
-            (&model, &div),
-            (active, pos, vel),
-            rheology_out,
-        );
+        let rheology_out = rheology.as_ref().map(|r| r.out.as_slice());
+        let (params, physics) = (&self.params, &self.model);
+        let kept = self.kept(draws);
+        let by_id = &mut self.by_id;
+        // The stores by id are serial: they run while the other threads fill the sides.
+        let ((), held) = self.pool.install(|| {
+            rayon::join(
+                || {
+                    let sides = (&model, &div);
+                    buffers.fill((params, physics), sides, (active, pos, vel), rheology_out);
+                },
+                || {
+                    let pass = rheology.as_ref()?;
+                    by_id.keep(pass, &b.ids, active, kept);
+                    // Read from the pass rather than from the words it stored by id: the
+                    // same flags.
+                    Some(pass.out.iter().map(|r| r.held).collect())
+                },
+            )
+        });
         let multiphase = rheology.is_some();
         let SideBuffers {
             sides,
@@ -142,144 +229,47 @@ impl CpuEngine {
         ForcePass {
             forces,
             dt_limit,
-            held,
+            held: held.unwrap_or_default(),
         }
     }
 
-    /// Fills `buffers` with the sides of the first `active` particles at `pos`, `vel` (sorted
-    /// order) as the force pass's pairs see them: with the holds and stresses of their
-    /// `rheology`, if the model has one. The stress sides go in the same parallel region as
-    /// the pair sides: a region costs a step more than its work at CI size (README, speed).
-    /// Each block writes its slots in place: an `unzip` joins the threads' pieces on one
-    /// thread.
-    fn fill_sides(
-        &self,
-        buffers: &mut SideBuffers,
-        (model, div): (&PairModel, &StressDivergence),
-        (active, pos, vel): (usize, &[[f32; 4]], &[[f32; 4]]),
-        rheology: Option<&[ParticleRheology]>,
-    ) {
-        let store = Store::new(&self.params, &self.model);
-        let bed_walls = self.bed_is_boundary();
-        let shields_only = self.params.sediment.shields_only != 0;
-        let side_of = |i: usize| {
-            let imposed = store.velocity_imposed(&pos[i]);
-            let side = model.side(&pos[i], &vel[i]);
-            // The Shields-only mode's held bed stands as a wall does (`physics::boundary`), or
-            // is fixed where it stands.
-            let held = rheology.is_some_and(|r| r[i].held);
-            let side = Side {
-                imposed,
-                mobile: side.mobile && !(bed_walls && held),
-                fixed: side.mobile && held && !bed_walls && shields_only,
-                ..side
-            };
-            (side, imposed)
-        };
-        let SideBuffers {
-            sides,
-            imposed,
-            stress,
-            mu,
-        } = buffers;
-        sides.resize(active, Side::default());
-        imposed.resize(active, false);
-        stress.resize(
-            if rheology.is_some() { active } else { 0 },
-            StressSide::default(),
-        );
-        mu.resize(stress.len(), 0.0);
-        let pair_sides = |b: usize, sides: &mut [Side], imposed: &mut [bool]| {
-            for (k, i) in (b * BLOCK..).take(sides.len()).enumerate() {
-                (sides[k], imposed[k]) = side_of(i);
-            }
-        };
-        self.pool.install(|| {
-            let own = sides
-                .par_chunks_mut(BLOCK)
-                .zip(imposed.par_chunks_mut(BLOCK));
-            match rheology {
-                None => own
-                    .enumerate()
-                    .for_each(|(b, (sides, imposed))| pair_sides(b, sides, imposed)),
-                Some(r) => {
-                    let theirs = stress.par_chunks_mut(BLOCK).zip(mu.par_chunks_mut(BLOCK));
-                    let blocks = own.zip(theirs).enumerate();
-                    blocks.for_each(|(b, ((sides, imposed), (stress, mu)))| {
-                        pair_sides(b, sides, imposed);
-                        for (k, i) in (b * BLOCK..).take(stress.len()).enumerate() {
-                            stress[k] = div.side(&pos[i], vel[i][3], &r[i].stress);
-                            mu[k] = r[i].mu;
-                        }
-                    });
-                }
-            }
-        });
-    }
-
     /// The rheology (and release) of the active particles of `b`, None without the
-    /// multiphase model; the regions it leaves are stored by id.
+    /// multiphase model; what it leaves them is the caller's to keep by id
+    /// ([`ById::keep`](super::by_id::ById::keep)).
     fn rheology(
         &mut self,
         grid: &Grid,
         b: &State,
         (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
         draws: Option<Draws>,
-    ) -> Option<Vec<ParticleRheology>> {
+    ) -> Option<RheologyPass> {
         let active = grid.active() as usize;
         let model = self.sediment.as_ref()?;
         let words = self.words(b);
         let holds = Holds {
             words: &words[..active],
             ids: &b.ids[..active],
-            fluxes: &self.fluxes,
+            fluxes: &self.by_id.fluxes,
             draws,
             awake_set: self.awake_set,
-            bed_tops: &self.bed_tops,
-            records: &self.records,
+            bed_tops: &self.by_id.bed_tops,
+            records: &self.by_id.records,
         };
         let release = self.shape.hold;
         let (params, pool) = (&self.model, &self.pool);
         let pass = rheology_pass(pool, params, model, grid, pos, vel, &holds, release);
         self.count(STAGE_RHEOLOGY, active, pass.asleep);
         self.walk_seconds[STAGE_RHEOLOGY] += pass.walk_s;
-        // One loop over the ids, not one for each store: these are serial, and the ids
-        // random.
+        Some(pass)
+    }
+
+    /// What a rheology pass that drew `draws` leaves by id besides the regions.
+    fn kept(&self, draws: Option<Draws>) -> Kept {
         let exner = self.sediment.as_ref().is_some_and(|m| m.exner());
-        let records = !pass.records.is_empty();
-        let wears = draws.is_some() && exner;
-        for (k, (r, &id)) in pass.out.iter().zip(&b.ids).enumerate() {
-            let id = id as usize;
-            self.regions[id] = r.word();
-            // The bed load of the pass that wore the bed, which the next one settles
-            // downstream.
-            if exner {
-                self.bed_tops[id] = bed_top_of(r);
-            }
-            // A held grain under the water sleeps by its last walk's record
-            // (`multiphase::deep`).
-            if records {
-                self.records[id] = pass.records[k];
-            }
-            if wears {
-                self.fluxes[id] = (r.flux, r.target);
-            }
+        Kept {
+            exner,
+            wears: draws.is_some() && exner,
         }
-        // Parked particles are out of the flow: no region, no walk, no load.
-        for &id in &b.ids[active..] {
-            let id = id as usize;
-            self.regions[id] = 0;
-            if exner {
-                self.bed_tops[id] = BED_UNKNOWN;
-            }
-            if records {
-                self.records[id] = f32::NAN;
-            }
-            if wears {
-                self.fluxes[id] = (NO_FLUX, NO_TARGET);
-            }
-        }
-        Some(pass.out)
     }
 
     /// One step; false once the chunk has no more to do (its time reached, or a health flag
@@ -438,7 +428,7 @@ impl CpuEngine {
     /// (`multiphase::deep`).
     fn forget_records(&mut self, held_parked: bool) {
         if held_parked {
-            self.records.fill(f32::NAN);
+            self.by_id.forget_records();
         }
     }
 }
