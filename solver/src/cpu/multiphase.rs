@@ -108,7 +108,7 @@ pub fn rheology_pass(
     let pass = Rheology::new(params, model).with_draws(holds.draws);
     let n = holds.words.len();
     let exner = model.exner();
-    let sleepers = Sleepers::new((params, model), &pass, grid, (pos, vel), holds);
+    let (sleepers, passed) = Sleepers::new(pool, (params, model), &pass, grid, (pos, vel), holds);
     // One parallel region, not two: a region costs a step more than its work at CI size
     // (README, speed). Each block writes its slots of the five in place: an `unzip` into
     // vectors gathers each thread's pieces and joins them on one thread.
@@ -133,9 +133,6 @@ pub fn rheology_pass(
             }
         });
     });
-    // Read only where the pass wears the bed (`Rheology::exchange_of`).
-    let wears = exner && holds.draws.is_some();
-    let passed = wears.then(|| passed(&fluxes, holds.ids, holds.fluxes.len()));
     let pairs = Pairs {
         params,
         pass: &pass,
@@ -200,28 +197,50 @@ struct Sleepers<'a> {
 }
 
 impl<'a> Sleepers<'a> {
+    /// The sleepers of a pass, and, where it wears the bed under Exner's balance, the bed
+    /// load passed to each particle by id ([`passed`]; read only there, by
+    /// `Rheology::exchange_of`). Four serial loops over the particles, two at a time: each
+    /// is a few microseconds on the CI flume, too little to share out.
     fn new(
+        pool: &rayon::ThreadPool,
         (params, model): (&Params, &SedimentModel),
         pass: &Rheology,
         grid: &'a Grid,
         (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
         holds: &'a Holds<'a>,
-    ) -> Sleepers<'a> {
+    ) -> (Sleepers<'a>, Option<Vec<f32>>) {
         let exner = model.exner();
-        let stirrers = holds
-            .awake_set
-            .then(|| stirring(params, (pos, vel), holds.words));
-        let deep = stirrers
-            .as_ref()
-            .and_then(|_| Deep::new(params, model, pass, (pos, vel), holds.words));
-        Sleepers {
+        let awake = holds.awake_set;
+        let wears = exner && holds.draws.is_some();
+        let ((stirrers, deep), (named, passed)) = pool.install(|| {
+            rayon::join(
+                || {
+                    rayon::join(
+                        || awake.then(|| stirring(params, (pos, vel), holds.words)),
+                        || {
+                            let words = holds.words;
+                            let deep = || Deep::new(params, model, pass, (pos, vel), words);
+                            awake.then(deep).flatten()
+                        },
+                    )
+                },
+                || {
+                    rayon::join(
+                        || exner.then(|| named(holds.fluxes)),
+                        || wears.then(|| passed(holds.fluxes, holds.ids)),
+                    )
+                },
+            )
+        });
+        let sleepers = Sleepers {
             grid,
             holds,
             stirrers,
-            named: exner.then(|| named(holds.fluxes)),
+            named,
             exner,
             deep,
-        }
+        };
+        (sleepers, passed)
     }
 
     /// Whether the grain at sorted index `i`, at `x`, sleeps, and whether its walk, if it
@@ -324,11 +343,14 @@ fn named(fluxes: &[(f32, u32)]) -> Vec<bool> {
 }
 
 /// By id, the bed load passed to each particle in the last pass that drew: the loads of the
-/// particles that named it, `fluxes` and `ids` in sorted order, summed in that order, as a
-/// walk over its neighbours ([`Exchange::add`]) sums them.
-fn passed(fluxes: &[(f32, u32)], ids: &[u32], by_id: usize) -> Vec<f32> {
-    let mut passed = vec![0.0f32; by_id];
-    for (&(flux, target), &id) in fluxes.iter().zip(ids) {
+/// particles that named it (`fluxes`, by id), summed in the sorted order of `ids`, as a walk
+/// over its neighbours ([`Exchange::add`]) sums them.
+fn passed(fluxes: &[(f32, u32)], ids: &[u32]) -> Vec<f32> {
+    let mut passed = vec![0.0f32; fluxes.len()];
+    for &id in ids {
+        let Some(&(flux, target)) = fluxes.get(id as usize) else {
+            continue;
+        };
         if flux < 0.0 || target == id {
             continue;
         }

@@ -249,10 +249,14 @@ fn held_grains_deep_under_the_water_sleep_by_their_last_walk() {
 
 /// The loads named to a grain are summed in sorted order, as its walk over its neighbours
 /// adds them: in f32, 4 + 4 + 1e8 is 1e8 + 8, where 1e8 + 4 + 4 rounds to 1e8. Loads of
-/// particles not at the bed's top, named to none or past the ids are passed to no one.
+/// particles not at the bed's top, named to none or past the ids are passed to no one, nor
+/// is that of a particle out of the flow (id 3, not among the sorted ids).
 #[test]
 fn the_loads_named_to_a_grain_are_summed_in_sorted_order() {
-    let fluxes = [
+    let mut fluxes = [(NO_FLUX, NO_TARGET); 11];
+    // Sorted order is not id order: summed by id, the 1e8 of id 0 would come first.
+    let ids = [9, 1, 4, 5, 8, 0, 6, 10];
+    let named = [
         (4.0, 2),
         (0.5, 3),
         (4.0, 2),
@@ -262,9 +266,14 @@ fn the_loads_named_to_a_grain_are_summed_in_sorted_order() {
         (9.0, 60),
         (2.0, 7),
     ];
-    let ids = [0, 1, 4, 5, 8, 9, 6, 10];
-    let by_id = passed(&fluxes, &ids, 8);
+    for (&id, &f) in ids.iter().zip(&named) {
+        fluxes[id as usize] = f;
+    }
+    fluxes[3] = (5.0, 2);
+    let by_id = passed(&fluxes, &ids);
     let in_order = 4.0_f32 + 4.0 + 1e8;
-    assert_eq!(by_id, vec![0.0, 0.0, in_order, 0.5, 0.0, 0.0, 0.0, 2.0]);
+    let mut want = vec![0.0; 11];
+    (want[2], want[3], want[7]) = (in_order, 0.5, 2.0);
+    assert_eq!(by_id, want);
     assert_ne!(in_order, 1e8_f32 + 4.0 + 4.0, "the order must matter");
 }
