@@ -413,32 +413,46 @@ mod tests {
 
     /// Whatever the storage order (shuffled, or the last sort's with particles moved on), the
     /// sort gives each cell's particles in id order, as a sort of the whole by (cell, id)
-    /// does: some cells hold a dozen.
+    /// does, and the parked ones after them in storage order: some cells hold a dozen, or,
+    /// with 5,000 particles, some fifty (the cells' parallel loop then splits among three
+    /// threads).
     #[test]
     fn the_sort_is_by_cell_then_id_from_any_storage_order() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .expect("a pool of three threads");
+        for n in [400, 5000] {
+            pool.install(|| sorted_as_a_whole(n));
+        }
+    }
+
+    fn sorted_as_a_whole(n: usize) {
         let (mut grid, cell) = twelve_by_nine();
+        let parked = 7;
         let mut next = lcg(5);
-        let n = 400;
         let mut pos: Vec<[f32; 4]> = (0..n)
             .map(|_| {
                 let x = (next() % 1000) as f32 * 0.012 * cell;
                 let y = (next() % 1000) as f32 * 0.009 * cell * (next() % 2) as f32;
-                [x, y, 0.0, 0.0]
+                let phase = if next() % 10 == 0 { parked } else { 0 };
+                [x, y, 0.0, f32::from_bits(phase)]
             })
             .collect();
-        let mut ids: Vec<u32> = (0..n as u32).map(|k| (k * 7919) % 1009).collect();
+        let mut ids: Vec<u32> = (0..n as u32).map(|k| (k * 7919) % 10007).collect();
         for round in 0..3 {
-            let order = grid.sort(&pos, &ids, None);
+            let order = grid.sort(&pos, &ids, Some(parked));
             let key = |i: u32| {
                 let x = &pos[i as usize];
-                (
-                    grid.index(grid.coords(&[x[0], x[1], x[2]])),
-                    ids[i as usize],
-                )
+                if x[3].to_bits() == parked {
+                    return (usize::MAX, 0);
+                }
+                let c = grid.index(grid.coords(&[x[0], x[1], x[2]]));
+                (c, ids[i as usize])
             };
             let mut expected: Vec<u32> = (0..n as u32).collect();
             expected.sort_by_key(|&i| key(i));
-            assert_eq!(order, expected, "round {round}");
+            assert_eq!(order, expected, "{n} particles, round {round}");
             // Stored in the sorted order, then moved by up to a cell.
             pos = gather(&pos, &order);
             ids = gather(&ids, &order);
