@@ -23,6 +23,10 @@
 //!
 //! Under the water a held grain deep in the bed sleeps too, where its last walk bounds its
 //! kernel mass over the surface threshold ([`deep`]).
+//!
+//! The release (Drucker-Prager) sums the stress of the moving sediment around a held grain:
+//! a grain with none in the cells within reach is not walked, since empty sums release
+//! nothing (`release_held`).
 
 use super::grid::{Flagged, Grid, Group};
 use super::simd;
