@@ -435,7 +435,7 @@ mod tests {
             .map(|_| {
                 let x = (next() % 1000) as f32 * 0.012 * cell;
                 let y = (next() % 1000) as f32 * 0.009 * cell * (next() % 2) as f32;
-                let phase = if next() % 10 == 0 { parked } else { 0 };
+                let phase = if next().is_multiple_of(10) { parked } else { 0 };
                 [x, y, 0.0, f32::from_bits(phase)]
             })
             .collect();
