@@ -20,15 +20,6 @@ pub(super) struct ById {
     pub records: Vec<f32>,
 }
 
-/// Which of [`ById`]'s arrays a rheology pass sets besides the regions.
-#[derive(Clone, Copy)]
-pub(super) struct Kept {
-    /// Where the bed is worn by Exner's balance: the bed tops.
-    pub exner: bool,
-    /// The pass drew, under Exner's balance: the bed loads it passed on.
-    pub wears: bool,
-}
-
 impl ById {
     /// Nothing known yet of `n` particles.
     pub fn new(n: usize) -> ById {
@@ -41,16 +32,17 @@ impl ById {
     }
 
     /// Keeps what `pass` left the particles `ids` (sorted order), the first `active` of them
-    /// in the flow. One loop over the ids, not one for each array: the ids are random, and
-    /// this runs beside the force pass's side filling (`step.rs`).
-    pub fn keep(&mut self, pass: &RheologyPass, ids: &[u32], active: usize, kept: Kept) {
+    /// in the flow: the regions, and the bed tops, records and bed loads where the pass has
+    /// them. One loop over the ids, not one for each array: the ids are random, and this runs
+    /// beside the force pass's side filling (`step.rs`).
+    pub fn keep(&mut self, pass: &RheologyPass, ids: &[u32], active: usize) {
         let records = !pass.records.is_empty();
         for (k, (r, &id)) in pass.out.iter().zip(ids).enumerate() {
             let id = id as usize;
             self.regions[id] = r.word();
             // The bed load of the pass that wore the bed, which the next one settles
             // downstream.
-            if kept.exner {
+            if pass.exner {
                 self.bed_tops[id] = bed_top_of(r);
             }
             // A held grain under the water sleeps by its last walk's record
@@ -58,7 +50,7 @@ impl ById {
             if records {
                 self.records[id] = pass.records[k];
             }
-            if kept.wears {
+            if pass.wears {
                 self.fluxes[id] = (r.flux, r.target);
             }
         }
@@ -66,16 +58,24 @@ impl ById {
         for &id in &ids[active..] {
             let id = id as usize;
             self.regions[id] = 0;
-            if kept.exner {
+            if pass.exner {
                 self.bed_tops[id] = BED_UNKNOWN;
             }
             if records {
                 self.records[id] = f32::NAN;
             }
-            if kept.wears {
+            if pass.wears {
                 self.fluxes[id] = (NO_FLUX, NO_TARGET);
             }
         }
+    }
+
+    /// Region words set from outside (`Engine::write_regions`): no walk's, so every grain
+    /// walks before it may sleep.
+    pub fn set_regions(&mut self, words: &[u32]) {
+        self.regions.copy_from_slice(words);
+        self.bed_tops.fill(BED_UNKNOWN);
+        self.forget_records();
     }
 
     /// After a held grain was parked, no record bounds a kernel mass it was in

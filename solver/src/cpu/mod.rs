@@ -292,10 +292,7 @@ impl Engine for CpuEngine {
     }
 
     fn write_regions(&mut self, words: &[u32]) {
-        self.by_id.regions.copy_from_slice(words);
-        // A word set from outside is no walk's: the grain walks before it may sleep.
-        self.by_id.bed_tops.fill(multiphase::BED_UNKNOWN);
-        self.by_id.forget_records();
+        self.by_id.set_regions(words);
     }
 
     fn forces(&mut self) -> Result<(Vec<[f32; 4]>, f32), SolverError> {

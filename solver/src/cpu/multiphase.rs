@@ -94,6 +94,10 @@ pub struct RheologyPass {
     /// Where held grains under the water may sleep ([`deep`]), the record each active particle
     /// leaves (sorted order; NaN: none), for [`Holds::records`]; empty elsewhere.
     pub records: Vec<f32>,
+    /// Under `van_rijn_exner`: the bed tops and, where the pass drew (`wears`), the bed loads
+    /// passed on are the pass's to keep too ([`Holds::bed_tops`], [`Holds::fluxes`]).
+    pub exner: bool,
+    pub wears: bool,
 }
 
 /// The rheology of the active particles (sorted order), then, with `release`, the release of
@@ -184,6 +188,8 @@ pub fn rheology_pass(
         asleep,
         walk_s,
         records,
+        exner,
+        wears: exner && holds.draws.is_some(),
     }
 }
 

@@ -4,7 +4,6 @@
 //! are `physics::integrate`'s; `store.rs` ends each particle's step, and `dt_update` mirrors
 //! `dt_update.wgsl`.
 
-use super::by_id::Kept;
 use super::forces::{Extra, force_pass, lane_use, min_dt};
 use super::grid::{Flagged, Grid};
 use super::multiphase::{Holds, RheologyPass, rheology_pass};
@@ -171,7 +170,6 @@ impl CpuEngine {
         let mut buffers = std::mem::take(&mut self.side_buffers);
         let rheology_out = rheology.as_ref().map(|r| r.out.as_slice());
         let (params, physics) = (&self.params, &self.model);
-        let kept = self.kept(draws);
         let by_id = &mut self.by_id;
         // The stores by id are serial: they run while the other threads fill the sides.
         let ((), held) = self.pool.install(|| {
@@ -182,7 +180,7 @@ impl CpuEngine {
                 },
                 || {
                     let pass = rheology.as_ref()?;
-                    by_id.keep(pass, &b.ids, active, kept);
+                    by_id.keep(pass, &b.ids, active);
                     // Read from the pass rather than from the words it stored by id: the
                     // same flags.
                     Some(pass.out.iter().map(|r| r.held).collect())
@@ -261,15 +259,6 @@ impl CpuEngine {
         self.count(STAGE_RHEOLOGY, active, pass.asleep);
         self.walk_seconds[STAGE_RHEOLOGY] += pass.walk_s;
         Some(pass)
-    }
-
-    /// What a rheology pass that drew `draws` leaves by id besides the regions.
-    fn kept(&self, draws: Option<Draws>) -> Kept {
-        let exner = self.sediment.as_ref().is_some_and(|m| m.exner());
-        Kept {
-            exner,
-            wears: draws.is_some() && exner,
-        }
     }
 
     /// One step; false once the chunk has no more to do (its time reached, or a health flag
