@@ -189,8 +189,14 @@ pub fn rheology_pass(
         walk_s,
         records,
         exner,
-        wears: exner && holds.draws.is_some(),
+        wears: wears(model, holds),
     }
+}
+
+/// Whether a pass wears the bed under Exner's balance: it draws the pick-ups, so the loads it
+/// passes on are settled downstream by the next pass ([`passed`]).
+fn wears(model: &SedimentModel, holds: &Holds) -> bool {
+    model.exner() && holds.draws.is_some()
 }
 
 /// What decides which held grains sleep in a pass (see the module doc).
@@ -221,7 +227,7 @@ impl<'a> Sleepers<'a> {
     ) -> (Sleepers<'a>, Option<Vec<f32>>) {
         let exner = model.exner();
         let awake = holds.awake_set;
-        let wears = exner && holds.draws.is_some();
+        let wears = wears(model, holds);
         let ((stirrers, deep), (named, passed)) = pool.install(|| {
             rayon::join(
                 || {
