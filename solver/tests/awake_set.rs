@@ -4,7 +4,10 @@
 //! water reaches walls and held sand that were dry: every particle's position, velocity and
 //! density, and every region word, must agree to the bit. A sleeper that water reached
 //! unnoticed (a wall still at rest density, a grain still held away from the surface) would
-//! differ from the step it was reached.
+//! differ from the step it was reached. With the awake set, an open flume's parked particles
+//! stored last also keep their slots from one sort to the next, uncopied (`cpu/step.rs`): a
+//! particle the inlet took from among them, or one newly parked, that the sort left where it
+//! was would differ too.
 
 mod common;
 

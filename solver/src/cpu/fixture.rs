@@ -121,7 +121,7 @@ pub fn fixture(viscosity: Viscosity) -> Fixture {
     sim.n_cells = dims[0] * dims[1];
     let mut grid = Grid::new(&sim, divisions);
     let ids: Vec<u32> = (0..pos.len() as u32).collect();
-    let order = grid.sort(&pos, &ids, None);
+    let order = grid.sort(&pos, &ids, None, pos.len());
     let pos = super::grid::gather(&pos, &order);
     let vel = super::grid::gather(&vel, &order);
     Fixture {

@@ -86,10 +86,19 @@ impl Grid {
     /// Sorts particles by (cell, id): returns, for each sorted slot, the storage index of its
     /// particle, and fills `starts`. Particles of phase `parked` (an open flume's reservoir)
     /// go after all cells, in storage order: no neighbour loop visits them. Particles of one
-    /// id in one cell keep their storage order.
-    pub fn sort(&mut self, positions: &[[f32; 4]], ids: &[u32], parked: Option<u32>) -> Vec<u32> {
+    /// id in one cell keep their storage order. The caller may know that every particle from
+    /// storage index `still` on is parked: those keep their slots, and are not looked at.
+    pub fn sort(
+        &mut self,
+        positions: &[[f32; 4]],
+        ids: &[u32],
+        parked: Option<u32>,
+        still: usize,
+    ) -> Vec<u32> {
+        let n = positions.len();
+        let still = if parked.is_some() { still.min(n) } else { n };
         let outside = self.starts.len() as u32 - 1;
-        let cells: Vec<u32> = positions
+        let cells: Vec<u32> = positions[..still]
             .par_iter()
             .with_min_len(PAR_MIN)
             .map(|p| {
@@ -108,7 +117,7 @@ impl Grid {
             self.starts[c] += self.starts[c - 1];
         }
         let mut cursor = self.starts.clone();
-        let mut order = vec![0u32; positions.len()];
+        let mut order: Vec<u32> = (0..n as u32).collect();
         let mut parked_slot = self.active() as usize;
         for (i, &c) in cells.iter().enumerate() {
             let slot = if c == outside {
@@ -400,20 +409,21 @@ mod tests {
             at(2.0, water),
         ];
         let ids = [6, 4, 1, 0, 2, 5, 3];
-        let order = grid.sort(&positions, &ids, Some(parked));
+        let order = grid.sort(&positions, &ids, Some(parked), positions.len());
         // Cell 0: ids 4, 2 (slots 1, 4) -> 2 then 4; cell 2: ids 6, 1, 3 -> 1, 3, 6; then
         // the parked slots 3 and 5 as stored.
         assert_eq!(order, [4, 1, 2, 6, 0, 3, 5]);
         assert_eq!(grid.active(), 5);
         // Id 4 twice, both in cell 0 (slots 1 and 4): both kept, in storage order.
         let ids = [6, 4, 1, 0, 4, 5, 3];
-        let order = grid.sort(&positions, &ids, Some(parked));
+        let order = grid.sort(&positions, &ids, Some(parked), positions.len());
         assert_eq!(order, [1, 4, 2, 6, 0, 3, 5]);
     }
 
     /// Whatever the storage order (shuffled, or the last sort's with particles moved on), the
     /// sort gives each cell's particles in id order, as a sort of the whole by (cell, id)
-    /// does, and the parked ones after them in storage order: some cells hold a dozen, or,
+    /// does, and the parked ones after them in storage order, whether or not the sort is told
+    /// where the parked ones stored last begin: some cells hold a dozen, or,
     /// with 5,000 particles, some fifty (the cells' parallel loop then splits among three
     /// threads).
     #[test]
@@ -440,8 +450,11 @@ mod tests {
             })
             .collect();
         let mut ids: Vec<u32> = (0..n as u32).map(|k| (k * 7919) % 10007).collect();
+        // After the first round the parked are stored last: the later sorts are told so.
+        let mut still = n;
         for round in 0..3 {
-            let order = grid.sort(&pos, &ids, Some(parked));
+            let order = grid.sort(&pos, &ids, Some(parked), still);
+            still = grid.active() as usize;
             let key = |i: u32| {
                 let x = &pos[i as usize];
                 if x[3].to_bits() == parked {
@@ -479,7 +492,7 @@ mod tests {
             }
         }
         let ids: Vec<u32> = (0..pos.len() as u32).collect();
-        let order = grid.sort(&pos, &ids, None);
+        let order = grid.sort(&pos, &ids, None, pos.len());
         let pos = gather(&pos, &order);
         let (mut inside, mut straddling) = (0, 0);
         for _ in 0..400 {
@@ -513,7 +526,7 @@ mod tests {
             }
         }
         let ids: Vec<u32> = (0..pos.len() as u32).collect();
-        let order = grid.sort(&pos, &ids, None);
+        let order = grid.sort(&pos, &ids, None, pos.len());
         let mut pos = gather(&pos, &order);
         // Half a step later every third particle has moved back by 0.6 cell.
         for x in pos.iter_mut().step_by(3) {

@@ -74,9 +74,16 @@ impl State {
     /// chunk writes its slots in place: collecting the four as a tuple goes through rayon's
     /// `unzip`, which joins the threads' pieces on one thread (README, speed).
     /// The buffers of `b` are reused: every slot is written, so only the ones a longer order
-    /// adds are set first.
-    fn gather(&self, order: &[u32], mut b: State) -> State {
+    /// adds are set first; or, where `b` is already the order's length, the slots from
+    /// `kept` on are taken to hold their particles already (the engine's `still` tail).
+    fn gather(&self, order: &[u32], mut b: State, kept: usize) -> State {
         let n = order.len();
+        let kept = if b.positions.len() == n {
+            kept.min(n)
+        } else {
+            n
+        };
+        let order = &order[..kept];
         b.positions.resize(n, [0.0; 4]);
         b.vel_rho.resize(n, [0.0; 4]);
         b.ids.resize(n, 0);
@@ -124,6 +131,11 @@ pub struct CpuEngine {
     /// memory.
     spare: State,
     side_buffers: step::SideBuffers,
+    /// Storage slots from `still` on hold parked particles that `a` and `spare` hold alike
+    /// at the same slots: the sort keeps them where they are, and neither its gather nor the
+    /// integrator copies them (`step.rs`). The state's length where nothing is known, and
+    /// always without the awake set.
+    still: usize,
     /// What the rheology passes leave each particle for the next, by id.
     by_id: ById,
     snapshot: Snapshot,
@@ -179,6 +191,7 @@ impl CpuEngine {
                 a: a.clone(),
                 by_id: by_id.clone(),
             },
+            still: a.positions.len(),
             a,
             spare: State::default(),
             side_buffers: step::SideBuffers::default(),
@@ -230,7 +243,11 @@ impl Engine for CpuEngine {
     }
 
     fn write_params(&mut self, params: &SimParams) {
+        let parked = self.parked_phase();
         self.params = *params;
+        if self.parked_phase() != parked {
+            self.still = self.a.positions.len();
+        }
         self.model = params.physics(self.shape.dim, self.model.phases.len());
     }
 
@@ -244,6 +261,7 @@ impl Engine for CpuEngine {
         let s = &self.snapshot;
         self.a.clone_from(&s.a);
         self.by_id.clone_from(&s.by_id);
+        self.still = self.a.positions.len();
     }
 
     fn run(&mut self, init: StepState, steps: u32) -> Result<StepState, SolverError> {
@@ -275,6 +293,8 @@ impl Engine for CpuEngine {
         self.a.positions[slot] = position;
         self.a.vel_rho[slot] = vel_rho;
         self.a.vel_rho_prev[slot] = vel_rho;
+        // The spare copy no longer holds this slot's particle.
+        self.still = self.still.max(slot + 1);
         // A particle placed from outside has taken no walk where it now stands.
         if let Some(r) = self.by_id.records.get_mut(self.a.ids[slot] as usize) {
             *r = f32::NAN;
@@ -369,11 +389,53 @@ mod tests {
             vel_rho_prev: vec![[-3.0; 4]; len],
         };
         for spare in [State::default(), junk(n + 500), junk(n / 3)] {
-            let b = a.gather(&order, spare);
+            let b = a.gather(&order, spare, n);
             assert_eq!(b.positions, gather(&a.positions, &order));
             assert_eq!(b.vel_rho, gather(&a.vel_rho, &order));
             assert_eq!(b.ids, gather(&a.ids, &order));
             assert_eq!(b.vel_rho_prev, gather(&a.vel_rho_prev, &order));
         }
+    }
+
+    /// Told that its slots from `kept` on hold their particles, a gather into buffers of the
+    /// order's length leaves them be and writes the rest; into buffers of another length it
+    /// writes every slot whatever it is told.
+    #[test]
+    fn a_gather_leaves_the_kept_slots_only_in_buffers_of_its_length() {
+        let (n, kept) = (3000usize, 2000usize);
+        let state = |shift: f32| State {
+            positions: (0..n).map(|k| [k as f32 + shift, 1.0, 2.0, 0.0]).collect(),
+            vel_rho: (0..n)
+                .map(|k| [0.5, k as f32 + shift, 0.0, 1000.0])
+                .collect(),
+            ids: (0..n as u32).map(|k| (k * 7) % n as u32).collect(),
+            vel_rho_prev: (0..n)
+                .map(|k| [0.0, 0.0, k as f32 + shift, 999.0])
+                .collect(),
+        };
+        let order: Vec<u32> = (0..n as u32)
+            .map(|k| {
+                if k < kept as u32 {
+                    (k * 1237) % kept as u32
+                } else {
+                    k
+                }
+            })
+            .collect();
+        let fresh = |a: &State| a.gather(&order, State::default(), n);
+        let (before, after) = (state(0.0), state(0.25));
+        let b = after.gather(&order, fresh(&before), kept);
+        let mut expected = fresh(&after);
+        let tail = kept..n;
+        expected.positions[tail.clone()].copy_from_slice(&before.positions[tail.clone()]);
+        expected.vel_rho[tail.clone()].copy_from_slice(&before.vel_rho[tail.clone()]);
+        expected.vel_rho_prev[tail.clone()].copy_from_slice(&before.vel_rho_prev[tail]);
+        assert_eq!(b.positions, expected.positions);
+        assert_eq!(b.vel_rho, expected.vel_rho);
+        assert_eq!(b.vel_rho_prev, expected.vel_rho_prev);
+        let mut longer = fresh(&before);
+        longer.positions.push([9.0; 4]);
+        let b = after.gather(&order, longer, kept);
+        assert_eq!(b.positions, fresh(&after).positions);
     }
 }

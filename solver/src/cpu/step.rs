@@ -123,14 +123,16 @@ impl SideBuffers {
 impl CpuEngine {
     /// Sorts the state into cells: the sorted copy and its grid.
     pub(super) fn sorted(&self) -> (Grid, State) {
-        self.sorted_into(State::default())
+        self.sorted_into(State::default(), self.a.positions.len())
     }
 
-    /// [`CpuEngine::sorted`] into the buffers of `spare`.
-    fn sorted_into(&self, spare: State) -> (Grid, State) {
+    /// [`CpuEngine::sorted`] into the buffers of `spare`, whose slots from `kept` on hold
+    /// their particles already.
+    fn sorted_into(&self, spare: State, kept: usize) -> (Grid, State) {
         let mut grid = self.grid();
-        let order = grid.sort(&self.a.positions, &self.a.ids, self.parked_phase());
-        (grid, self.a.gather(&order, spare))
+        let (a, parked) = (&self.a, self.parked_phase());
+        let order = grid.sort(&a.positions, &a.ids, parked, self.still);
+        (grid, a.gather(&order, spare, kept))
     }
 
     /// The region word the last rheology pass left each mobile particle of `b` (sorted
@@ -266,7 +268,7 @@ impl CpuEngine {
     pub(super) fn step(&mut self, st: &mut StepState) -> bool {
         let start = Instant::now();
         let spare = std::mem::take(&mut self.spare);
-        let (grid, b) = self.sorted_into(spare);
+        let (grid, b) = self.sorted_into(spare, self.still);
         self.timed(STAGE_SORT, start);
         let mut pass = ForcePass::default();
         if st.t_rel < st.t_target && st.status == 0 {
@@ -285,7 +287,7 @@ impl CpuEngine {
         }
         if self.shape.verlet {
             let start = Instant::now();
-            self.verlet(st, b, &pass);
+            self.verlet(st, &grid, b, &pass);
             self.timed(STAGE_INTEGRATE, start);
         } else {
             self.symplectic(st, &grid, b, &pass);
@@ -293,18 +295,18 @@ impl CpuEngine {
         st.status == 0
     }
 
-    fn verlet(&mut self, st: &mut StepState, b: State, pass: &ForcePass) {
+    fn verlet(&mut self, st: &mut StepState, grid: &Grid, b: State, pass: &ForcePass) {
         // dt_update has counted this step already.
         let euler = (st.step_base + st.steps - 1).is_multiple_of(self.params.euler_every.max(1));
         let (dt, dt_prev) = (st.dt, st.dt_prev);
         let store = Store::new(&self.params, &self.model);
         let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
-        let (next, held_parked) = Self::store_all(&self.pool, st, buffers, |i| {
+        let (next, held_parked) = Self::store_all(&self.pool, st, (buffers, self.still), |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
             let Some(f) = pass.forces.get(i) else {
-                // Parked: out of the flow.
-                return ((*x, *v), *v, Event::default());
+                // Parked: out of the flow, kept as it is.
+                return ((*x, *v), b.vel_rho_prev[i], Event::default());
             };
             let held = pass.held(i);
             let phase = store.phase(x);
@@ -318,7 +320,7 @@ impl CpuEngine {
             let prev = if held { [0.0, 0.0, 0.0, v[3]] } else { *v };
             (out, prev, event)
         });
-        self.a_after(b, next);
+        self.a_after(b, next, grid.active() as usize);
         self.forget_records(held_parked);
     }
 
@@ -353,7 +355,7 @@ impl CpuEngine {
         let store = Store::new(&self.params, &self.model);
         let bed_walls = self.bed_is_boundary();
         let buffers = std::mem::take(&mut self.a);
-        let (next, held_parked) = Self::store_all(&self.pool, st, buffers, |i| {
+        let (next, held_parked) = Self::store_all(&self.pool, st, (buffers, self.still), |i| {
             let (x, v) = (&b.positions[i], &b.vel_rho[i]);
             let Some(f) = half.forces.get(i) else {
                 return ((*x, *v), b.vel_rho_prev[i], Event::default());
@@ -367,7 +369,7 @@ impl CpuEngine {
             let (out, event) = store.apply(b.ids[i], x, v, held, dt, moved);
             (out, b.vel_rho_prev[i], event)
         });
-        self.a_after(b, next);
+        self.a_after(b, next, grid.active() as usize);
         self.forget_records(held_parked);
         self.timed(STAGE_INTEGRATE, start);
     }
@@ -382,18 +384,21 @@ impl CpuEngine {
 
     /// Stores each particle (`store_one(i)`: where it goes, its velocity of the step
     /// before and what storing it did), in parallel, straight into the state that follows
-    /// (the buffers of the state before, whose sorted copy the step read); the events, rare,
-    /// are tallied in sorted order. The state's ids are left to the caller. Returns it, and
-    /// whether a held grain was parked.
+    /// (the buffers of the state before, whose sorted copy the step read), up to slot
+    /// `still`: the parked ones after it are there already. The events, rare, are tallied in
+    /// sorted order. The state's ids are left to the caller. Returns it, and whether a held
+    /// grain was parked.
     fn store_all(
         pool: &rayon::ThreadPool,
         st: &mut StepState,
-        mut next: State,
+        (mut next, still): (State, usize),
         store_one: impl Fn(usize) -> (Particle, [f32; 4], Event) + Sync,
     ) -> (State, bool) {
+        let still = still.min(next.positions.len());
         let events: Vec<Event> = pool.install(|| {
-            let out = next.positions.par_iter_mut().zip(&mut next.vel_rho);
-            out.zip(&mut next.vel_rho_prev)
+            let out = next.positions[..still].par_iter_mut();
+            let out = out.zip(&mut next.vel_rho[..still]);
+            out.zip(&mut next.vel_rho_prev[..still])
                 .enumerate()
                 .filter_map(|(i, ((x, v), prev))| {
                     let ((x_new, v_new), prev_new, event) = store_one(i);
@@ -407,10 +412,22 @@ impl CpuEngine {
     }
 
     /// Makes `next` (with the ids of `b`, whose order it was stored in) the state, and keeps
-    /// what is left of both as the next sort's buffers.
-    fn a_after(&mut self, b: State, next: State) {
+    /// what is left of both as the next sort's buffers. The parked particles, from slot
+    /// `active` of the sort on, are then alike in both: with the awake set, the next sort
+    /// keeps them in place.
+    fn a_after(&mut self, b: State, mut next: State, active: usize) {
+        // The slots the sort kept held the same ids before and after it; those the newly
+        // parked took did not.
+        let moved = active..self.still.min(b.ids.len()).max(active);
+        next.ids[moved.clone()].copy_from_slice(&b.ids[moved]);
         self.spare = State { ids: next.ids, ..b };
         self.a = State { ids: b.ids, ..next };
+        // Without the awake set every particle is sorted and stored in full.
+        self.still = if self.awake_set {
+            active
+        } else {
+            self.a.positions.len()
+        };
     }
 
     /// After a held grain was parked, no record bounds a kernel mass it was in
