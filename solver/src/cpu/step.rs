@@ -135,10 +135,10 @@ impl CpuEngine {
         (grid, a.gather(&order, spare, kept))
     }
 
-    /// The region word the last rheology pass left each mobile particle of `b` (sorted
-    /// order); 0 for the others.
-    fn words(&self, b: &State) -> Vec<u32> {
-        let words = b.positions.iter().zip(&b.ids);
+    /// The region word the last rheology pass left each mobile particle of the first
+    /// `active` of `b` (sorted order); 0 for the others.
+    fn words(&self, b: &State, active: usize) -> Vec<u32> {
+        let words = b.positions[..active].iter().zip(&b.ids);
         words.map(|(x, &id)| self.word(x, id)).collect()
     }
 
@@ -245,9 +245,9 @@ impl CpuEngine {
     ) -> Option<RheologyPass> {
         let active = grid.active() as usize;
         let model = self.sediment.as_ref()?;
-        let words = self.words(b);
+        let words = self.words(b, active);
         let holds = Holds {
-            words: &words[..active],
+            words: &words,
             ids: &b.ids[..active],
             fluxes: &self.by_id.fluxes,
             draws,
