@@ -408,7 +408,9 @@ mod tests {
             vel_rho: (0..n)
                 .map(|k| [0.5, k as f32 + shift, 0.0, 1000.0])
                 .collect(),
-            ids: (0..n as u32).map(|k| (k * 7) % n as u32).collect(),
+            ids: (0..n as u32)
+                .map(|k| (k * 7 + (shift * 4.0) as u32) % n as u32)
+                .collect(),
             vel_rho_prev: (0..n)
                 .map(|k| [0.0, 0.0, k as f32 + shift, 999.0])
                 .collect(),
@@ -429,8 +431,10 @@ mod tests {
         let tail = kept..n;
         expected.positions[tail.clone()].copy_from_slice(&before.positions[tail.clone()]);
         expected.vel_rho[tail.clone()].copy_from_slice(&before.vel_rho[tail.clone()]);
-        expected.vel_rho_prev[tail.clone()].copy_from_slice(&before.vel_rho_prev[tail]);
+        expected.vel_rho_prev[tail.clone()].copy_from_slice(&before.vel_rho_prev[tail.clone()]);
+        expected.ids[tail.clone()].copy_from_slice(&before.ids[tail]);
         assert_eq!(b.positions, expected.positions);
+        assert_eq!(b.ids, expected.ids);
         assert_eq!(b.vel_rho, expected.vel_rho);
         assert_eq!(b.vel_rho_prev, expected.vel_rho_prev);
         let mut longer = fresh(&before);
