@@ -133,12 +133,14 @@ fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
 }
 
 /// The paper's numerics on the same flume (dynamic boundaries, the held sand a mobile phase
-/// held at rest): walls sleep in the force pass, held grains in the rheology pass only.
+/// held fixed at rest): walls sleep in the force pass, those under the held bed too, and held
+/// grains in the rheology pass.
 #[test]
 fn the_papers_flume_with_its_awake_set_is_the_full_computation() {
     let case = ulbra(&[]);
     let [first, last] = assert_same_as_full(&case, &[0.5, 2.0]);
-    assert!(first.0 > 0.2 && first.1 > 0.1, "{first:?}");
+    // Without the walls under the bed, 0.11 of the force pass slept.
+    assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
     assert!(last.0 < first.0, "{first:?} then {last:?}");
 }
 

@@ -10,8 +10,9 @@
 //! output is its density. Under the generalised condition that comes from its wall sums over
 //! the fluid (`physics::boundary`), taken for a group's walls in lanes as the pair sums are
 //! (one test of a wall neighbour spares all eight lanes), and its pair sums are not computed.
-//! Under DBC its rate sums the mobile particles alone (`PairModel::add_pair`): with none in
-//! the cells within reach it is exactly zero, and the wall is not visited. A dry wall under
+//! Under DBC its rate sums the mobile particles alone (`PairModel::add_pair`), each pair by the
+//! velocity difference: with none in the cells within reach but walls and held sand at rest
+//! ([`wakes`]) it is exactly zero, and the wall is not visited. A dry wall under
 //! the generalised condition takes rest density without a neighbour loop. Each of these is
 //! the value the full sums give, to the bit (`tests/awake_set.rs`); nothing a mobile particle
 //! reads is skipped, since every mobile particle runs its own sums.
@@ -38,9 +39,9 @@ pub struct Extra<'a> {
     /// Particles whose velocity is imposed (an open flume's inlet buffer and duct): their
     /// acceleration does not bound the step. Empty: none.
     pub imposed: &'a [bool],
-    /// The mobile particles, whose presence within reach wakes a wall; None: every wall runs
-    /// its full sums (the full computation the awake set is checked against).
-    pub mobile: Option<&'a Flagged>,
+    /// The particles whose presence within reach wakes a wall ([`wakes`]); None: every wall
+    /// runs its full sums (the full computation the awake set is checked against).
+    pub waking: Option<&'a Flagged>,
 }
 
 /// What one block of the pass reads.
@@ -235,9 +236,9 @@ impl Pass<'_> {
     #[inline(always)]
     fn wall_of(&self, i: usize) -> (bool, bool) {
         let side = &self.sides[i];
-        match self.extra.mobile {
-            Some(mobile) if !side.mobile => {
-                let wet = self.grid.any_near(mobile, &side.x);
+        match self.extra.waking {
+            Some(waking) if !side.mobile => {
+                let wet = self.grid.any_near(waking, &side.x);
                 (wet, self.model.params().generalised_walls || !wet)
             }
             _ => (true, false),
@@ -327,6 +328,14 @@ impl Pass<'_> {
     }
 }
 
+/// Whether a particle wakes the walls within reach: any mobile particle but the held sand
+/// fixed where it stands (DBC under the Shields-only mode), and anything that moves. Under
+/// the generalised condition a wall's density comes from the fluid around it, still or not;
+/// no sand is fixed there.
+pub fn wakes(side: &Side) -> bool {
+    (side.mobile && !side.fixed) || side.v != [0.0; 3]
+}
+
 /// The smallest stable step over particles, s (f32::MAX when none bounds it, as the GPU's
 /// reduction starts).
 pub fn min_dt(dt_limit: &[f32]) -> f32 {
@@ -410,7 +419,7 @@ mod tests {
         let extra = Extra {
             stress: None,
             imposed: &[],
-            mobile: None,
+            waking: None,
         };
         let lanes = lane_use(&pool, &model, &fx.grid, &sides, &extra);
         assert_eq!(lanes.useful, brute);
@@ -442,14 +451,14 @@ mod tests {
             let imposed: Vec<bool> = (0..sides.len()).map(|i| i % 7 == 0).collect();
             let with_stress = matches!(viscosity, Viscosity::Multiphase { .. });
             let n = sides.len();
-            let mobile = Flagged::new(n, |k| sides[k].mobile);
+            let waking = Flagged::new(n, |k| wakes(&sides[k]));
             let full = Extra {
                 stress: with_stress.then_some((&div, stress.as_slice(), mu.as_slice())),
                 imposed: &imposed,
-                mobile: None,
+                waking: None,
             };
             let awake = Extra {
-                mobile: Some(&mobile),
+                waking: Some(&waking),
                 ..full
             };
             let pass = |extra| Pass {

@@ -4,7 +4,7 @@
 //! are `physics::integrate`'s; `store.rs` ends each particle's step, and `dt_update` mirrors
 //! `dt_update.wgsl`.
 
-use super::forces::{Extra, force_pass, lane_use, min_dt};
+use super::forces::{Extra, force_pass, lane_use, min_dt, wakes};
 use super::grid::{Flagged, Grid};
 use super::multiphase::{Holds, RheologyPass, rheology_pass};
 use super::store::{Event, Store, tally};
@@ -196,13 +196,13 @@ impl CpuEngine {
             stress,
             mu,
         } = &buffers;
-        let mobile = self
+        let waking = self
             .awake_set
-            .then(|| Flagged::new(active, |k| sides[k].mobile));
+            .then(|| Flagged::new(active, |k| wakes(&sides[k])));
         let extra = Extra {
             stress: multiphase.then_some((&div, stress.as_slice(), mu.as_slice())),
             imposed,
-            mobile: mobile.as_ref(),
+            waking: waking.as_ref(),
         };
         let (mut forces, mut dt_limit) = (vec![[0.0; 4]; active], vec![0.0; active]);
         let walk = Instant::now();
