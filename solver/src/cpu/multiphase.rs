@@ -18,8 +18,12 @@
 //! it: it does not sleep. And a grain at the bed's top offers to take load (a flux of 0, not
 //! `NO_FLUX`), which the particle that names a target reads in the next pass that draws; its
 //! own start cannot tell it, but its last walk did ([`Holds::bed_tops`]): its neighbours have
-//! not moved since, for a neighbour that moves is one that stirs. A grain whose last walk is
-//! not known (none yet, or its word set from outside) does not sleep.
+//! not moved since, for a neighbour that moves is one that stirs. That walk weighed its
+//! neighbours' volumes too, so their densities must not have changed either: under Exner's
+//! balance a wall or held grain at rest stirs as well where its density is not its rest
+//! density, as a wall's or a held bed's is where water in its own reach sets it
+//! (`physics::boundary`). A grain whose last walk is not known (none yet, or its word set from
+//! outside) does not sleep.
 //!
 //! Under the water a held grain deep in the bed sleeps too, where its last walk bounds its
 //! kernel mass over the surface threshold ([`deep`]).
@@ -232,7 +236,7 @@ impl<'a> Sleepers<'a> {
             rayon::join(
                 || {
                     rayon::join(
-                        || awake.then(|| stirring(params, (pos, vel), holds.words)),
+                        || awake.then(|| stirring(params, (pos, vel), holds.words, exner)),
                         || {
                             let words = holds.words;
                             let deep = || Deep::new(params, model, pass, (pos, vel), words);
@@ -337,12 +341,21 @@ fn release_held(
 }
 
 /// The particles that stir a held grain's neighbourhood: any but held grains and walls at
-/// rest. A held grain with none of them in the cells within reach sleeps (see the module doc).
-fn stirring(params: &Params, (pos, vel): (&[[f32; 4]], &[[f32; 4]]), words: &[u32]) -> Flagged {
+/// rest, and under Exner's balance (`exner`) those too where their density is not their rest
+/// density. A held grain with none of them in the cells within reach sleeps (see the module
+/// doc).
+fn stirring(
+    params: &Params,
+    (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+    words: &[u32],
+    exner: bool,
+) -> Flagged {
     let rests = |k: usize| {
         let still = vel[k][..3].iter().all(|&v| v == 0.0);
         let held = words[k] & REGION_HELD != 0;
-        still && (held || !params.phases[phase_index(&pos[k])].mobile)
+        let phase = &params.phases[phase_index(&pos[k])];
+        let settled = !exner || vel[k][3] == phase.rho0;
+        still && settled && (held || !phase.mobile)
     };
     Flagged::new(words.len(), |k| !rests(k))
 }
