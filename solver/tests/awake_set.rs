@@ -92,6 +92,21 @@ fn ulbra(overrides: &[&str]) -> Case {
         .expect("the CI flume")
 }
 
+/// The CI flume with the twin's numerics (`scripts/run.sh`), its bed worn by `erosion`, and
+/// `more` overrides.
+fn twin(erosion: &str, more: &[&str]) -> Case {
+    let erosion = format!("phases.1.sediment.erosion={erosion}");
+    let mut set = vec![
+        "numerics.boundary={method: generalised}",
+        "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
+        &erosion,
+        "phases.1.sediment.shields_speed=water",
+        "phases.1.sediment.comes_to_rest=beside_a_solid",
+    ];
+    set.extend(more);
+    ulbra(&set)
+}
+
 /// The CI flume as the twin runs it (generalised walls, the held bed a wall, van Rijn's
 /// pick-up worn net of what settles, `van_rijn_exner`): the front crosses 2 m of dry bed in its
 /// first 4 s, waking walls and held sand as it goes, and carries the load it picks up to the
@@ -100,13 +115,7 @@ fn ulbra(overrides: &[&str]) -> Case {
 /// under it sleep by their last walk (`cpu/multiphase/deep.rs`).
 #[test]
 fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
-    let case = ulbra(&[
-        "numerics.boundary={method: generalised}",
-        "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
-        "phases.1.sediment.erosion=van_rijn_exner",
-        "phases.1.sediment.shields_speed=water",
-        "phases.1.sediment.comes_to_rest=beside_a_solid",
-    ]);
+    let case = twin("van_rijn_exner", &[]);
     let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5, 6.0, 10.0]);
     // Not vacuous: walls and grains slept, and the front woke some (fewer slept at the end).
     assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
@@ -124,13 +133,7 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
 /// by 8.45 s.
 #[test]
 fn the_twins_flume_at_a_large_step_is_the_full_computation() {
-    let case = ulbra(&[
-        "numerics.boundary={method: generalised}",
-        "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
-        "phases.1.sediment.erosion=van_rijn_exner",
-        "phases.1.sediment.shields_speed=water",
-        "phases.1.sediment.comes_to_rest=beside_a_solid",
-    ]);
+    let case = twin("van_rijn_exner", &[]);
     let full = Backend::Cpu {
         threads: 2,
         awake_set: false,
@@ -156,14 +159,10 @@ fn the_twins_flume_at_a_large_step_is_the_full_computation() {
 /// and the half step's velocities, with the pick-up worn away alone (`van_rijn_integrated`).
 #[test]
 fn the_twins_flume_under_the_symplectic_scheme_is_the_full_computation() {
-    let case = ulbra(&[
-        "numerics.boundary={method: generalised}",
-        "numerics.viscosity={method: multiphase, eddy_m2_per_s: 3.95e-5}",
-        "phases.1.sediment.erosion=van_rijn_integrated",
-        "phases.1.sediment.shields_speed=water",
-        "phases.1.sediment.comes_to_rest=beside_a_solid",
-        "numerics.integrator={method: symplectic}",
-    ]);
+    let case = twin(
+        "van_rijn_integrated",
+        &["numerics.integrator={method: symplectic}"],
+    );
     let [first, _] = assert_same_as_full(&case, &[0.5, 2.0]);
     assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
 }
