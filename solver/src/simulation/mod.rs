@@ -69,6 +69,15 @@ pub struct Simulation {
     exclusion_log: ExclusionLog,
 }
 
+/// The host's part of what a recovery rolls back to ([`Simulation::save`]).
+struct Saved {
+    time_s: f64,
+    /// Steps, the last step's length and the last step taken.
+    clock: (u64, f64, f32),
+    flume: Option<FlumeState>,
+    pores: Option<PoreColumns>,
+}
+
 impl Simulation {
     pub fn new(backend: impl Into<Backend>, case: &Case) -> Result<Simulation, SolverError> {
         let backend = backend.into();
@@ -256,10 +265,7 @@ impl Simulation {
                 reason: format!("must be a finite time in s, got {target_s}"),
             });
         }
-        let saved = (self.time_s, self.steps, self.last_dt_s, self.dt_taken);
-        let saved_flume = self.flume.clone();
-        let saved_pores = self.pores.clone();
-        self.engine.save();
+        let saved = self.save();
         let mut tries = 0;
         // When the first try failed, and whether every retry failed at about the same time:
         // an unstable step fails after about as many steps whatever their length, so halving
@@ -286,7 +292,7 @@ impl Simulation {
             };
             let (first_s, tolerance_s) = *first_failure.get_or_insert_with(|| {
                 // One step, or a tenth of the time from the restored state to the failure.
-                (time_s, self.last_dt_s.max(0.1 * (time_s - saved.0)))
+                (time_s, self.last_dt_s.max(0.1 * (time_s - saved.time_s)))
             });
             same_time &= (time_s - first_s).abs() <= tolerance_s;
             if tries >= MAX_RECOVERIES_PER_CHUNK {
@@ -300,10 +306,7 @@ impl Simulation {
             }
             tries += 1;
             self.clean_chunks = 0;
-            self.engine.restore();
-            (self.time_s, self.steps, self.last_dt_s, self.dt_taken) = saved;
-            self.flume.clone_from(&saved_flume);
-            self.pores.clone_from(&saved_pores);
+            self.roll_back(&saved);
             self.params.cfl *= 0.5;
             self.engine.write_params(&self.params);
             log::warn!(
@@ -319,6 +322,27 @@ impl Simulation {
                 cfl: f64::from(self.params.cfl),
             });
         }
+    }
+
+    /// Saves what a recovery rolls back to: the engine's state (`Engine::save`) and the
+    /// host's clock, inlet and pores.
+    fn save(&mut self) -> Saved {
+        self.engine.save();
+        Saved {
+            time_s: self.time_s,
+            clock: (self.steps, self.last_dt_s, self.dt_taken),
+            flume: self.flume.clone(),
+            pores: self.pores.clone(),
+        }
+    }
+
+    /// Rolls the run back to `saved`, the engine to its last save.
+    fn roll_back(&mut self, saved: &Saved) {
+        self.engine.restore();
+        self.time_s = saved.time_s;
+        (self.steps, self.last_dt_s, self.dt_taken) = saved.clock;
+        self.flume.clone_from(&saved.flume);
+        self.pores.clone_from(&saved.pores);
     }
 
     fn restore_cfl_when_calm(&mut self) {
@@ -503,3 +527,6 @@ impl Simulation {
         Ok(obs)
     }
 }
+
+#[cfg(test)]
+mod tests;
