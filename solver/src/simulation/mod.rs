@@ -72,8 +72,9 @@ pub struct Simulation {
 /// The host's part of what a recovery rolls back to ([`Simulation::save`]).
 struct Saved {
     time_s: f64,
-    /// Steps, the last step's length and the last step taken.
-    clock: (u64, f64, f32),
+    steps: u64,
+    last_dt_s: f64,
+    dt_taken: f32,
     flume: Option<FlumeState>,
     pores: Option<PoreColumns>,
 }
@@ -330,7 +331,9 @@ impl Simulation {
         self.engine.save();
         Saved {
             time_s: self.time_s,
-            clock: (self.steps, self.last_dt_s, self.dt_taken),
+            steps: self.steps,
+            last_dt_s: self.last_dt_s,
+            dt_taken: self.dt_taken,
             flume: self.flume.clone(),
             pores: self.pores.clone(),
         }
@@ -339,8 +342,8 @@ impl Simulation {
     /// Rolls the run back to `saved`, the engine to its last save.
     fn roll_back(&mut self, saved: &Saved) {
         self.engine.restore();
-        self.time_s = saved.time_s;
-        (self.steps, self.last_dt_s, self.dt_taken) = saved.clock;
+        (self.time_s, self.steps) = (saved.time_s, saved.steps);
+        (self.last_dt_s, self.dt_taken) = (saved.last_dt_s, saved.dt_taken);
         self.flume.clone_from(&saved.flume);
         self.pores.clone_from(&saved.pores);
     }
