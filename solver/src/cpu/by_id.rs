@@ -18,6 +18,9 @@ pub(super) struct ById {
     /// What each held grain's last walk bounds its kernel mass by (NaN: none;
     /// `multiphase::Holds::records`).
     pub records: Vec<f32>,
+    /// Under `van_rijn_exner`, whether the last pass found each particle with nothing that
+    /// stirs in reach (`multiphase::Holds::dry_before`).
+    pub dry: Vec<bool>,
 }
 
 impl ById {
@@ -28,6 +31,7 @@ impl ById {
             fluxes: vec![(NO_FLUX, NO_TARGET); n],
             bed_tops: vec![BED_UNKNOWN; n],
             records: vec![f32::NAN; n],
+            dry: vec![false; n],
         }
     }
 
@@ -44,6 +48,7 @@ impl ById {
             // downstream.
             if pass.exner {
                 self.bed_tops[id] = bed_top_of(r);
+                self.dry[id] = pass.dry[k];
             }
             // A held grain under the water sleeps by its last walk's record
             // (`multiphase::deep`).
@@ -60,6 +65,7 @@ impl ById {
             self.regions[id] = 0;
             if pass.exner {
                 self.bed_tops[id] = BED_UNKNOWN;
+                self.dry[id] = false;
             }
             if records {
                 self.records[id] = f32::NAN;
@@ -79,8 +85,10 @@ impl ById {
     }
 
     /// After a held grain was parked, no record bounds a kernel mass it was in
-    /// (`multiphase::deep`).
+    /// (`multiphase::deep`), and no dry grain's last walk is known to have weighed the
+    /// neighbours it has now.
     pub fn forget_records(&mut self) {
         self.records.fill(f32::NAN);
+        self.dry.fill(false);
     }
 }

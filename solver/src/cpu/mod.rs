@@ -296,8 +296,12 @@ impl Engine for CpuEngine {
         // The spare copy no longer holds this slot's particle.
         self.still = self.still.max(slot + 1);
         // A particle placed from outside has taken no walk where it now stands.
-        if let Some(r) = self.by_id.records.get_mut(self.a.ids[slot] as usize) {
+        let id = self.a.ids[slot] as usize;
+        if let Some(r) = self.by_id.records.get_mut(id) {
             *r = f32::NAN;
+        }
+        if let Some(d) = self.by_id.dry.get_mut(id) {
+            *d = false;
         }
     }
 

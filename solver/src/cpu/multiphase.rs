@@ -23,7 +23,12 @@
 //! balance a wall or held grain at rest stirs as well where its density is not its rest
 //! density, as a wall's or a held bed's is where water in its own reach sets it
 //! (`physics::boundary`). A grain whose last walk is not known (none yet, or its word set from
-//! outside) does not sleep.
+//! outside) does not sleep. Nor does a grain whose last pass found something that stirs in
+//! reach: its last walk then weighed water that has since gone, or a density that has since
+//! come back to rest, or it slept by a record taken under the water. It walks once dry, and
+//! from then on its neighbours are those that walk weighed: none has moved, and each has kept
+//! its rest density, or it would have stirred. After a held grain is parked (`ById`), every
+//! grain walks again.
 //!
 //! Under the water a held grain deep in the bed sleeps too, where its last walk bounds its
 //! kernel mass over the surface threshold ([`deep`]).
@@ -69,6 +74,9 @@ pub struct Holds<'a> {
     /// What each held grain's last walk bounds its kernel mass by, by id
     /// ([`RheologyPass::records`]; NaN: none); empty where no grain sleeps under the water.
     pub records: &'a [f32],
+    /// Under `van_rijn_exner`, whether the last pass found each particle with nothing that
+    /// stirs in reach, by id ([`RheologyPass::dry`]); empty: none.
+    pub dry_before: &'a [bool],
 }
 
 /// A particle's last walk found it at the bed's top ([`Holds::bed_tops`]).
@@ -98,6 +106,9 @@ pub struct RheologyPass {
     /// Where held grains under the water may sleep ([`deep`]), the record each active particle
     /// leaves (sorted order; NaN: none), for [`Holds::records`]; empty elsewhere.
     pub records: Vec<f32>,
+    /// Whether each active particle had nothing that stirs in reach (sorted order): a dry
+    /// grain sleeps only where the pass before found it dry too (see the module doc).
+    pub dry: Vec<bool>,
     /// Under `van_rijn_exner`: the bed tops and, where the pass drew (`wears`), the bed loads
     /// passed on are the pass's to keep too ([`Holds::bed_tops`], [`Holds::fluxes`]).
     pub exner: bool,
@@ -121,46 +132,23 @@ pub fn rheology_pass(
     let n = holds.words.len();
     let exner = model.exner();
     let (sleepers, passed) = Sleepers::new(pool, (params, model), &pass, grid, (pos, vel), holds);
-    // One parallel region, not two: a region costs a step more than its work at CI size
-    // (README, speed). Each block writes its slots of the five in place: an `unzip` into
-    // vectors gathers each thread's pieces and joins them on one thread.
-    let mut vol = vec![0.0; n];
-    let mut fluxes = vec![(NO_FLUX, NO_TARGET); n];
-    let mut sides = vec![RheologySide::default(); n];
-    let (mut asleep, mut recordable) = (vec![false; n], vec![false; n]);
-    pool.install(|| {
-        let own = vol.par_chunks_mut(BLOCK).zip(fluxes.par_chunks_mut(BLOCK));
-        let sleep = asleep
-            .par_chunks_mut(BLOCK)
-            .zip(recordable.par_chunks_mut(BLOCK));
-        let blocks = own.zip(sides.par_chunks_mut(BLOCK)).zip(sleep).enumerate();
-        blocks.for_each(|(b, (((vol, fluxes), sides), (asleep, recordable)))| {
-            for (k, i) in (b * BLOCK..).take(vol.len()).enumerate() {
-                sides[k] = pass.side(&pos[i], &vel[i]);
-                (asleep[k], recordable[k]) = sleepers.state(i, &sides[k].x);
-                // In sorted order: the loads are summed and weighed in that order.
-                let flux = holds.fluxes.get(holds.ids[i] as usize);
-                fluxes[k] = *flux.unwrap_or(&(NO_FLUX, NO_TARGET));
-                vol[k] = pass.volume(&pos[i], &vel[i]);
-            }
-        });
-    });
+    let own = Own::new(pool, &pass, &sleepers, holds, (pos, vel));
     let pairs = Pairs {
         params,
         pass: &pass,
         grid,
         pos,
         vel,
-        vol: &vol,
-        sides: &sides,
+        vol: &own.vol,
+        sides: &own.sides,
         ids: holds.ids,
-        fluxes: &fluxes,
+        fluxes: &own.fluxes,
         passed: passed.as_deref().unwrap_or_default(),
         words: holds.words,
-        asleep: &asleep,
+        asleep: &own.asleep,
         bed_tops: exner.then_some(holds.bed_tops),
         deep: sleepers.deep.as_ref(),
-        recordable: &recordable,
+        recordable: &own.recordable,
         records: holds.records,
     };
     // Every slot is written by its block.
@@ -192,8 +180,75 @@ pub fn rheology_pass(
         asleep,
         walk_s,
         records,
+        dry: own.dry,
         exner,
         wears: wears(model, holds),
+    }
+}
+
+/// What the walk reads of each active particle besides its position and velocity, and how it
+/// sleeps (sorted order).
+struct Own {
+    vol: Vec<f32>,
+    /// The last pass's bed load and where it went (`Holds::fluxes`).
+    fluxes: Vec<(f32, u32)>,
+    sides: Vec<RheologySide>,
+    asleep: Vec<bool>,
+    /// Whether its walk leaves a record ([`deep`]).
+    recordable: Vec<bool>,
+    /// [`RheologyPass::dry`].
+    dry: Vec<bool>,
+}
+
+impl Own {
+    /// One parallel region, not two: a region costs a step more than its work at CI size
+    /// (README, speed). Each block writes its slots of the six in place: an `unzip` into
+    /// vectors gathers each thread's pieces and joins them on one thread.
+    fn new(
+        pool: &rayon::ThreadPool,
+        pass: &Rheology,
+        sleepers: &Sleepers,
+        holds: &Holds,
+        (pos, vel): (&[[f32; 4]], &[[f32; 4]]),
+    ) -> Own {
+        let n = holds.words.len();
+        let mut own = Own {
+            vol: vec![0.0; n],
+            fluxes: vec![(NO_FLUX, NO_TARGET); n],
+            sides: vec![RheologySide::default(); n],
+            asleep: vec![false; n],
+            recordable: vec![false; n],
+            dry: vec![false; n],
+        };
+        let Own {
+            vol,
+            fluxes,
+            sides,
+            asleep,
+            recordable,
+            dry,
+        } = &mut own;
+        pool.install(|| {
+            let mine = vol.par_chunks_mut(BLOCK).zip(fluxes.par_chunks_mut(BLOCK));
+            let sleep = asleep
+                .par_chunks_mut(BLOCK)
+                .zip(recordable.par_chunks_mut(BLOCK))
+                .zip(dry.par_chunks_mut(BLOCK));
+            let blocks = mine.zip(sides.par_chunks_mut(BLOCK)).zip(sleep).enumerate();
+            blocks.for_each(
+                |(b, (((vol, fluxes), sides), ((asleep, recordable), dry)))| {
+                    for (k, i) in (b * BLOCK..).take(vol.len()).enumerate() {
+                        sides[k] = pass.side(&pos[i], &vel[i]);
+                        (asleep[k], recordable[k], dry[k]) = sleepers.state(i, &sides[k].x);
+                        // In sorted order: the loads are summed and weighed in that order.
+                        let flux = holds.fluxes.get(holds.ids[i] as usize);
+                        fluxes[k] = *flux.unwrap_or(&(NO_FLUX, NO_TARGET));
+                        vol[k] = pass.volume(&pos[i], &vel[i]);
+                    }
+                },
+            );
+        });
+        own
     }
 }
 
@@ -263,20 +318,29 @@ impl<'a> Sleepers<'a> {
         (sleepers, passed)
     }
 
-    /// Whether the grain at sorted index `i`, at `x`, sleeps, and whether its walk, if it
-    /// takes one, leaves a record ([`deep`]): a dry held grain sleeps, and under the water a
+    /// Whether the grain at sorted index `i`, at `x`, sleeps, whether its walk, if it takes
+    /// one, leaves a record ([`deep`]), and whether it is dry: a dry held grain sleeps (under
+    /// Exner's balance only where the pass before found it dry too), and under the water a
     /// quiet one whose record allows.
-    fn state(&self, i: usize, x: &[f32; 3]) -> (bool, bool) {
+    fn state(&self, i: usize, x: &[f32; 3]) -> (bool, bool, bool) {
+        // A particle not held stirs itself (`stirring`): it is not dry.
         if self.holds.words[i] & REGION_HELD == 0 {
-            return (false, false);
+            return (false, false, false);
         }
         let dry = (self.stirrers.as_ref()).is_some_and(|s| !self.grid.any_near(s, x));
         if dry {
-            return (self.may_sleep(i), self.deep.is_some());
+            let walked_dry = !self.exner || self.dry_before(i);
+            return (walked_dry && self.may_sleep(i), self.deep.is_some(), true);
         }
         let quiet = self.deep.as_ref().is_some_and(|d| d.quiet(self.grid, x));
         let deep_asleep = quiet && self.deep.as_ref().is_some_and(|d| d.sleeps(self.record(i)));
-        (deep_asleep && self.may_sleep(i), quiet)
+        (deep_asleep && self.may_sleep(i), quiet, false)
+    }
+
+    /// Whether the pass before found the grain at sorted index `i` dry.
+    fn dry_before(&self, i: usize) -> bool {
+        let id = self.holds.ids[i] as usize;
+        self.holds.dry_before.get(id).is_some_and(|&d| d)
     }
 
     /// Under Exner's balance a grain sleeps only where its last walk is known and no load was

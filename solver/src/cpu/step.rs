@@ -254,6 +254,7 @@ impl CpuEngine {
             awake_set: self.awake_set,
             bed_tops: &self.by_id.bed_tops,
             records: &self.by_id.records,
+            dry_before: &self.by_id.dry,
         };
         let release = self.shape.hold;
         let (params, pool) = (&self.model, &self.pool);

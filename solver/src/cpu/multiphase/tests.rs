@@ -60,6 +60,7 @@ fn each_lane_gets_the_rheology_of_its_particle_alone() {
             awake_set,
             bed_tops: &[],
             records: &[],
+            dry_before: &[],
         };
         let (pos, vel) = (&fx.pos, &fx.vel);
         rheology_pass(&pool, params, &fx.sediment, grid, pos, vel, &holds, false).out
@@ -155,6 +156,7 @@ fn under_exner_a_grain_that_names_none_still_takes_what_was_named_to_it() {
             awake_set,
             bed_tops: &bed_tops,
             records: &[],
+            dry_before: &[],
         };
         let (pos, vel) = (&fx.pos, &fx.vel);
         let got = rheology_pass(&pool, params, &model, grid, pos, vel, &holds, false).out;
@@ -172,6 +174,107 @@ fn under_exner_a_grain_that_names_none_still_takes_what_was_named_to_it() {
     assert!(
         want.iter().any(|r| r.target != NO_TARGET),
         "none named a target"
+    );
+}
+
+/// Under Exner's balance a dry grain sleeps by the bed-top flag of its last walk only where
+/// that walk was taken dry: one that weighed water gone since walks once more. On the
+/// fixture's bed (its ends open faces) with every wall and held grain at rest at its rest
+/// density, the water is in reach of the upper rows, then parked (out of the flow, as an open
+/// flume's reservoir): the grains of the bed's ends lay at its surface beside the water, and
+/// dry they no longer lie at its top. Two passes without the water must then give what the
+/// full computation gives.
+#[test]
+fn under_exner_a_grain_the_water_left_walks_once_dry() {
+    use crate::cpu::fixture::{WALL, WATER};
+    let model = fixture(Viscosity::Multiphase {
+        alpha: 0.05,
+        sps_length2: 0.0,
+    })
+    .sediment
+    .worn_by_van_rijn(true);
+    let at_rest = |fx: &mut Fixture| {
+        for (x, v) in fx.pos.iter().zip(fx.vel.iter_mut()) {
+            let phase = x[3].to_bits();
+            if phase == SAND || phase == WALL {
+                *v = [0.0, 0.0, 0.0, fx.params.phases[phase as usize].rho0];
+            }
+        }
+    };
+    let mut wet = fixture(Viscosity::Multiphase {
+        alpha: 0.05,
+        sps_length2: 0.0,
+    });
+    at_rest(&mut wet);
+    let n = wet.pos.len();
+    let held = |x: &[f32; 4]| {
+        if x[3].to_bits() == SAND {
+            REGION_HELD
+        } else {
+            0
+        }
+    };
+    let fluxes = vec![(NO_FLUX, NO_TARGET); n];
+    let pool = two_threads();
+    let pass = |fx: &Fixture, ids: &[u32], awake_set: bool, known: (&[u8], &[bool])| {
+        let active = fx.grid.active() as usize;
+        let words: Vec<u32> = fx.pos[..active].iter().map(held).collect();
+        let holds = Holds {
+            words: &words,
+            ids: &ids[..active],
+            fluxes: &fluxes,
+            draws: None,
+            awake_set,
+            bed_tops: known.0,
+            records: &[],
+            dry_before: known.1,
+        };
+        let (pos, vel) = (&fx.pos, &fx.vel);
+        rheology_pass(&pool, &fx.params, &model, &fx.grid, pos, vel, &holds, false)
+    };
+    // What a pass leaves by id, as `ById::keep` keeps it.
+    let keep = |r: &RheologyPass, ids: &[u32]| {
+        let (mut tops, mut dry) = (vec![BED_UNKNOWN; n], vec![false; n]);
+        for (k, out) in r.out.iter().enumerate() {
+            (tops[ids[k] as usize], dry[ids[k] as usize]) = (bed_top_of(out), r.dry[k]);
+        }
+        (tops, dry)
+    };
+    let wet_ids: Vec<u32> = (0..n as u32).collect();
+    let first = pass(&wet, &wet_ids, true, (&vec![BED_UNKNOWN; n], &[]));
+    let (tops, dry) = keep(&first, &wet_ids);
+    // The water parked: the same bed, sorted again without it.
+    let mut gone = fixture(Viscosity::Multiphase {
+        alpha: 0.05,
+        sps_length2: 0.0,
+    });
+    at_rest(&mut gone);
+    let order = gone.grid.sort(&gone.pos, &wet_ids, Some(WATER), n);
+    gone.pos = crate::cpu::grid::gather(&gone.pos, &order);
+    gone.vel = crate::cpu::grid::gather(&gone.vel, &order);
+    let ids = order;
+    let outcome = |r: &RheologyPass| -> Vec<(u32, u32, u32)> {
+        let out = r.out.iter();
+        out.map(|p| (p.word(), p.flux.to_bits(), p.target))
+            .collect()
+    };
+    let full = pass(&gone, &ids, false, (&tops, &dry));
+    let second = pass(&gone, &ids, true, (&tops, &dry));
+    assert!(outcome(&second) == outcome(&full), "the first pass dry");
+    let (tops_after, dry_after) = keep(&second, &ids);
+    let third = pass(&gone, &ids, true, (&tops_after, &dry_after));
+    assert!(outcome(&third) == outcome(&full), "the second pass dry");
+    // Not vacuous: some grain's flag changed with the water gone, and once walked dry the
+    // grains slept.
+    let moved = (0..ids.len().min(full.out.len()))
+        .filter(|&k| tops[ids[k] as usize] != bed_top_of(&full.out[k]))
+        .count();
+    assert!(moved > 0, "no grain's bed-top flag changed");
+    assert!(
+        third.asleep > second.asleep,
+        "{} {}",
+        second.asleep,
+        third.asleep
     );
 }
 
@@ -212,6 +315,7 @@ fn held_grains_deep_under_the_water_sleep_by_their_last_walk() {
             awake_set: true,
             bed_tops: &[],
             records,
+            dry_before: &[],
         };
         let (pos, vel) = (&fx.pos, &fx.vel);
         rheology_pass(&pool, &fx.params, &model, &fx.grid, pos, vel, &holds, false)
