@@ -118,7 +118,10 @@ fn the_twins_flume_with_its_awake_set_is_the_full_computation() {
     let case = twin("van_rijn_exner", &[]);
     let [first, last] = assert_same_as_full(&case, &[0.5, 1.5, 2.5, 3.5, 6.0, 10.0]);
     // Not vacuous: walls and grains slept, and the front woke some (fewer slept at the end).
-    assert!(first.0 > 0.2 && first.1 > 0.3, "{first:?}");
+    // To 0.5 s the dry bed ahead of the front sleeps: 0.964 of the rheology's particles. With
+    // no grain sleeping dry (the engine forgetting which grains its last pass found dry, so
+    // that each walks every pass) only the walls do, 0.500 (tried); the bound lies between.
+    assert!(first.0 > 0.9 && first.1 > 0.3, "{first:?}");
     assert!(
         last.0 < first.0 && last.1 < first.1,
         "{first:?} then {last:?}"

@@ -106,8 +106,9 @@ pub struct RheologyPass {
     /// Where held grains under the water may sleep ([`deep`]), the record each active particle
     /// leaves (sorted order; NaN: none), for [`Holds::records`]; empty elsewhere.
     pub records: Vec<f32>,
-    /// Whether each active particle had nothing that stirs in reach (sorted order): a dry
-    /// grain sleeps only where the pass before found it dry too (see the module doc).
+    /// Whether each active particle is a held grain with nothing that stirs in reach (sorted
+    /// order): a dry grain sleeps only where the pass before found it dry too (see the module
+    /// doc).
     pub dry: Vec<bool>,
     /// Under `van_rijn_exner`: the bed tops and, where the pass drew (`wears`), the bed loads
     /// passed on are the pass's to keep too ([`Holds::bed_tops`], [`Holds::fluxes`]).
